@@ -1,0 +1,10 @@
+#pragma once
+/// @file cmc33.hpp
+/// Umbrella header of the cmc33 library.
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/mesh.hpp"
+#include "cmc33/topology.hpp"
+#include "cmc33/version.hpp"
+#include "cmc33/volume.hpp"

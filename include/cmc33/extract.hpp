@@ -1,0 +1,57 @@
+#pragma once
+/// @file extract.hpp
+/// The isosurface extractor: Marching Cubes 33 with the corrections of Custodio, Etiene, Pesco and
+/// Silva 2013 (method `cmc33`), and for comparison the earlier MC33 (`mc33-lewiner`) and classic
+/// Marching Cubes (`mc`). One code path; only the decision policy differs.
+
+#include <array>
+#include <cstdint>
+#include <string_view>
+
+#include "cmc33/mesh.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33 {
+
+enum class Method {
+    cmc33,        ///< default: topologically correct and manifold
+    mc33_lewiner, ///< MC33 with the flaws the 2013 paper describes (t_alt, case 10/12 branch, 13.5)
+    mc,           ///< classic Marching Cubes: one triangulation per sign configuration
+};
+
+std::string_view method_name(Method method) noexcept; ///< "cmc33", "mc33-lewiner", "mc"
+/// @throws Error{invalid_argument} naming the accepted names.
+Method parse_method(std::string_view name);
+
+/// Subcases of Chernyaev's table, numbered 0..32 in the order
+/// 0, 1, 2, 3.1, 3.2, 4.1.1, 4.1.2, 5, 6.1.1, 6.1.2, 6.2, 7.1, 7.2, 7.3, 7.4.1, 7.4.2, 8, 9,
+/// 10.1.1, 10.1.2, 10.2, 11, 12.1.1, 12.1.2, 12.2, 12.3, 13.1, 13.2, 13.3, 13.4, 13.5.1, 13.5.2, 14.
+inline constexpr int kSubcaseCount = 33;
+std::string_view subcase_name(int subcase) noexcept;
+
+struct ExtractOptions {
+    Method method = Method::cmc33;
+    bool normals = false; ///< per-vertex normals from the field's gradient (central differences)
+    int threads = 0;      ///< 0: all cores. The mesh is byte-identical for every thread count.
+};
+
+struct ExtractStats {
+    std::array<std::int64_t, kSubcaseCount> cells_per_subcase{}; ///< cells the surface crosses
+};
+
+/// Extracts S = {x : f(x) = iso}, f the trilinear interpolant of the samples.
+///
+/// Sign rule: a sample (or face or interior saddle) equal to iso counts as above it.
+/// One vertex per crossed grid edge, shared by every cell around that edge; cells whose subcase
+/// needs them add interior vertices. Triangles wind counter-clockwise seen from below iso: normals
+/// point from the above-iso side to the below-iso side (docs/conventions.md).
+///
+/// @param grid  at least 2 samples on each axis
+/// @throws Error{invalid_argument} if an axis has < 2 samples; Error{non_finite} if iso or a
+///         sample is NaN or infinite (the message says how many and where the first is)
+/// Cost: O(cells) time; working memory O(slices); no allocation inside a pass.
+template <class T>
+Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
+Mesh extract(const Volume& volume, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
+
+} // namespace cmc33

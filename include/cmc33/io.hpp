@@ -1,0 +1,63 @@
+#pragma once
+/// @file io.hpp
+/// Reading and writing volumes and meshes. The format follows the file name's extension.
+///
+/// Volumes: NRRD (.nrrd attached, .nhdr detached; raw or gzip), MetaImage (.mhd/.mha), VTK legacy
+/// STRUCTURED_POINTS (.vtk, binary or ASCII), and headerless raw (any other name, with RawOptions).
+/// Meshes: PLY (binary little-endian by default, or ASCII), OBJ, binary STL, OFF.
+///
+/// Every reader checks every size it is told against what the file holds before allocating, and
+/// throws `Error` with a one-line message that names the file, what is wrong and what was expected.
+/// Writers write a temporary file next to the target and rename it, so a failed write never leaves
+/// a half-written file behind.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include "cmc33/mesh.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33::io {
+
+enum class Endian { little, big };
+
+/// What a headerless raw file cannot say about itself.
+struct RawOptions {
+    Index3 dims{0, 0, 0};
+    ScalarType type = ScalarType::u8;
+    Vec3 spacing{1, 1, 1};
+    Endian endian = Endian::little;
+    std::uint64_t header_bytes = 0; ///< bytes to skip at the start
+};
+
+/// Parses "int8|uint8|int16|uint16|int32|uint32|float|double" (also "char", "uchar", "short",
+/// "ushort", "int", "uint", "float32", "float64"). @throws Error{invalid_argument}.
+ScalarType parse_type(const std::string& name);
+
+/// Reads a volume; `raw` is required for headerless files and ignored otherwise.
+/// Samples are converted to the machine's byte order.
+/// @throws Error (io_error, truncated_file, bad_format, unsupported_format, too_large)
+Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw = std::nullopt);
+
+/// Writes a volume: .nrrd (attached, raw), .nhdr (+ .raw beside it), .mhd (+ .raw), .mha,
+/// .vtk (binary, big-endian), .raw (headerless, machine order). @throws Error.
+void write_volume(const Volume& volume, const std::filesystem::path& path);
+
+struct MeshWriteOptions {
+    bool ascii = false; ///< PLY only: ASCII instead of binary little-endian
+};
+
+/// Writes .ply, .obj, .stl (binary) or .off. Normals are written where the format carries them
+/// (PLY, OBJ). @throws Error{unsupported_format} for another extension, Error{io_error}.
+void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
+
+/// Reads .ply (ASCII or binary, either endian), .obj, .stl (binary or ASCII) or .off. Polygons
+/// with more than three vertices are fanned. STL has no indices: exactly coincident vertices are
+/// welded. @throws Error.
+Mesh read_mesh(const std::filesystem::path& path);
+
+/// True for names whose extension read_volume() knows without RawOptions.
+bool has_volume_header(const std::filesystem::path& path);
+
+} // namespace cmc33::io

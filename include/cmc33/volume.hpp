@@ -1,0 +1,143 @@
+#pragma once
+/// @file volume.hpp
+/// Volumes: `Volume` owns typed samples; `GridView<T>` is the non-owning view the extractor and
+/// the verifier read. Samples are stored x fastest, then y, then z (C order [z][y][x]), in the
+/// machine's byte order. World position of sample (i, j, k) = origin + spacing * (i, j, k).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+
+#include "cmc33/error.hpp"
+
+namespace cmc33 {
+
+enum class ScalarType { i8, u8, i16, u16, i32, u32, f32, f64 };
+
+/// "int8", "uint8", "int16", "uint16", "int32", "uint32", "float", "double".
+std::string_view type_name(ScalarType type) noexcept;
+/// Size of one sample in bytes.
+std::size_t type_size(ScalarType type) noexcept;
+
+template <class T> constexpr ScalarType scalar_type_of();
+template <> constexpr ScalarType scalar_type_of<std::int8_t>() { return ScalarType::i8; }
+template <> constexpr ScalarType scalar_type_of<std::uint8_t>() { return ScalarType::u8; }
+template <> constexpr ScalarType scalar_type_of<std::int16_t>() { return ScalarType::i16; }
+template <> constexpr ScalarType scalar_type_of<std::uint16_t>() { return ScalarType::u16; }
+template <> constexpr ScalarType scalar_type_of<std::int32_t>() { return ScalarType::i32; }
+template <> constexpr ScalarType scalar_type_of<std::uint32_t>() { return ScalarType::u32; }
+template <> constexpr ScalarType scalar_type_of<float>() { return ScalarType::f32; }
+template <> constexpr ScalarType scalar_type_of<double>() { return ScalarType::f64; }
+
+using Index3 = std::array<std::int64_t, 3>;
+using Vec3 = std::array<double, 3>;
+
+/// Non-owning view of samples of type T. Unit x-stride is required; y and z strides are in
+/// elements, so a view can cover a sub-block of a larger array without copying.
+template <class T> struct GridView {
+    const T* data = nullptr;
+    Index3 dims{0, 0, 0};    ///< samples along x, y, z
+    Index3 strides{1, 0, 0}; ///< element strides; strides[0] must be 1
+    Vec3 spacing{1, 1, 1};
+    Vec3 origin{0, 0, 0};
+
+    /// A dense view: strides {1, nx, nx*ny}.
+    static GridView dense(const T* data, Index3 dims, Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0})
+    {
+        return GridView{data, dims, {1, dims[0], dims[0] * dims[1]}, spacing, origin};
+    }
+    std::int64_t nx() const noexcept { return dims[0]; }
+    std::int64_t ny() const noexcept { return dims[1]; }
+    std::int64_t nz() const noexcept { return dims[2]; }
+    std::int64_t offset(std::int64_t i, std::int64_t j, std::int64_t k) const noexcept
+    {
+        return i + j * strides[1] + k * strides[2];
+    }
+    T operator()(std::int64_t i, std::int64_t j, std::int64_t k) const noexcept { return data[offset(i, j, k)]; }
+};
+
+/// Owns the samples of a volume read from a file or made by the caller.
+class Volume {
+public:
+    Volume() = default;
+    /// Allocates zeroed samples. @throws Error{too_large} if the size overflows or an axis < 1.
+    Volume(ScalarType type, Index3 dims, Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0});
+
+    ScalarType type() const noexcept { return type_; }
+    const Index3& dims() const noexcept { return dims_; }
+    const Vec3& spacing() const noexcept { return spacing_; }
+    const Vec3& origin() const noexcept { return origin_; }
+    void set_spacing(const Vec3& s) noexcept { spacing_ = s; }
+    void set_origin(const Vec3& o) noexcept { origin_ = o; }
+    std::int64_t sample_count() const noexcept { return dims_[0] * dims_[1] * dims_[2]; }
+    std::size_t byte_size() const noexcept { return static_cast<std::size_t>(sample_count()) * type_size(type_); }
+    std::byte* bytes() noexcept { return data_.get(); }
+    const std::byte* bytes() const noexcept { return data_.get(); }
+
+    /// Typed access. @throws Error{invalid_argument} if T is not the stored type.
+    template <class T> T* samples()
+    {
+        check_type(scalar_type_of<T>());
+        return reinterpret_cast<T*>(data_.get());
+    }
+    template <class T> const T* samples() const
+    {
+        check_type(scalar_type_of<T>());
+        return reinterpret_cast<const T*>(data_.get());
+    }
+    template <class T> GridView<T> view() const
+    {
+        return GridView<T>::dense(samples<T>(), dims_, spacing_, origin_);
+    }
+
+    /// Calls f(GridView<T>) with T the stored sample type; returns what f returns.
+    template <class F> decltype(auto) visit(F&& f) const;
+
+private:
+    void check_type(ScalarType wanted) const;
+    ScalarType type_ = ScalarType::u8;
+    Index3 dims_{0, 0, 0};
+    Vec3 spacing_{1, 1, 1};
+    Vec3 origin_{0, 0, 0};
+    std::unique_ptr<std::byte[]> data_;
+};
+
+/// Calls f with a default-constructed value of the C++ type of `type` (dispatch helper).
+template <class F> decltype(auto) dispatch_scalar_type(ScalarType type, F&& f)
+{
+    switch (type) {
+    case ScalarType::i8: return f(std::int8_t{});
+    case ScalarType::u8: return f(std::uint8_t{});
+    case ScalarType::i16: return f(std::int16_t{});
+    case ScalarType::u16: return f(std::uint16_t{});
+    case ScalarType::i32: return f(std::int32_t{});
+    case ScalarType::u32: return f(std::uint32_t{});
+    case ScalarType::f32: return f(float{});
+    case ScalarType::f64: break;
+    }
+    return f(double{});
+}
+
+template <class F> decltype(auto) Volume::visit(F&& f) const
+{
+    return dispatch_scalar_type(type_, [&](auto tag) -> decltype(auto) {
+        using T = decltype(tag);
+        return f(view<T>());
+    });
+}
+
+/// Count and first position (x, y, z) of NaN or infinite samples; count 0 for integer types.
+struct NonFinite {
+    std::int64_t count = 0;
+    Index3 first{-1, -1, -1};
+};
+NonFinite find_non_finite(const Volume& volume);
+
+/// Smallest and largest sample (non-finite samples skipped).
+std::pair<double, double> value_range(const Volume& volume);
+
+} // namespace cmc33

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs the Debian packages cmc33 needs to build and test, and nothing else.
+# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench]
+#   --bench  also the peers the benchmark compares against (VTK, scikit-image)
+set -euo pipefail
+
+packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgtest-dev libgmock-dev
+          libcli11-dev nlohmann-json3-dev libtbb-dev python3)
+if [[ "${1:-}" == "--bench" ]]; then
+    packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time)
+fi
+
+missing=()
+for p in "${packages[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[[ ${#missing[@]} -eq 0 ]] && exit 0
+
+echo "install-deps: installing ${missing[*]}" >&2
+sudo=""
+[[ $(id -u) -ne 0 ]] && sudo="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

@@ -1,0 +1,64 @@
+#include "test_support.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace cmc33::test {
+
+std::filesystem::path temp_dir()
+{
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    std::string name = info ? std::string(info->test_suite_name()) + "." + info->name() : "no_test";
+    for (char& c : name) {
+        if (c == '/') c = '_';
+    }
+    const auto dir = std::filesystem::temp_directory_path() / "cmc33-tests" / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir;
+}
+
+std::optional<std::filesystem::path> shared_volume(const std::string& file_name)
+{
+    const char* shared = std::getenv("CMC33_SHARED");
+    if (shared == nullptr) return std::nullopt;
+    const auto path = std::filesystem::path(shared) / "data" / "volumes" / file_name;
+    if (!std::filesystem::exists(path)) return std::nullopt;
+    return path;
+}
+
+std::filesystem::path test_data_dir()
+{
+    const char* dir = std::getenv("CMC33_TEST_DATA");
+    return dir ? std::filesystem::path(dir) : std::filesystem::path("tests/data");
+}
+
+void write_file(const std::filesystem::path& path, const std::string& bytes)
+{
+    std::ofstream out(path, std::ios::binary);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::string read_file(const std::filesystem::path& path)
+{
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+Volume make_volume(Index3 dims, const std::function<double(std::int64_t, std::int64_t, std::int64_t)>& f,
+                   Vec3 spacing, Vec3 origin)
+{
+    Volume v(ScalarType::f64, dims, spacing, origin);
+    double* p = v.samples<double>();
+    for (std::int64_t k = 0; k < dims[2]; ++k)
+        for (std::int64_t j = 0; j < dims[1]; ++j)
+            for (std::int64_t i = 0; i < dims[0]; ++i) *p++ = f(i, j, k);
+    return v;
+}
+
+} // namespace cmc33::test

@@ -1,0 +1,31 @@
+#pragma once
+// Helpers shared by the test executables: temporary folders, the shared volumes, small fields.
+
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "cmc33/volume.hpp"
+
+namespace cmc33::test {
+
+/// A fresh, empty folder for the running test (removed at the start of the next run).
+std::filesystem::path temp_dir();
+
+/// Path of a volume in ../shared/data/volumes, or nullopt when shared/ is not beside the repo.
+std::optional<std::filesystem::path> shared_volume(const std::string& file_name);
+
+/// Folder of the repository's small test files (tests/data).
+std::filesystem::path test_data_dir();
+
+/// Writes bytes to a file (for building bad inputs).
+void write_file(const std::filesystem::path& path, const std::string& bytes);
+std::string read_file(const std::filesystem::path& path);
+
+/// A double volume of the given dims filled by f(i, j, k).
+Volume make_volume(Index3 dims, const std::function<double(std::int64_t, std::int64_t, std::int64_t)>& f,
+                   Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0});
+
+} // namespace cmc33::test
