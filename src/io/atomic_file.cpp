@@ -22,8 +22,10 @@ void write_atomically(const std::filesystem::path& path, const std::function<voi
     if (std::filesystem::is_directory(path, ec)) {
         throw Error(Status::io_error, path.string() + ": cannot write, it is a directory");
     }
-    const std::filesystem::path temp =
-        dir / ("." + path.filename().string() + ".tmp" + std::to_string(::getpid()) + "." + std::to_string(counter++));
+    std::string temp_name = ".";  // built piecewise: g++ 12 warns falsely on "." + string (-Wrestrict)
+    temp_name += path.filename().string();
+    temp_name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    const std::filesystem::path temp = dir / temp_name;
     try {
         std::ofstream out(temp, std::ios::binary | std::ios::trunc);
         if (!out) throw Error(Status::io_error, path.string() + ": cannot create a file in " + dir.string());
