@@ -1,0 +1,355 @@
+// extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges):
+//   1. classify + decide + count: per row of cells, the case code of each cell, its face and
+//      interior tests (run once, the chosen tiling stored in one byte per cell), and the number of
+//      vertices (crossed edges owned by the row's samples, interior vertices) and triangles;
+//   2. scan: prefix sums give every row its first vertex and first triangle;
+//   3. emit vertices: each crossed grid edge is owned by its lower sample and gets one vertex;
+//   4. emit triangles: every cell writes its tiling's triangles and interior vertices at its row's
+//      offsets, finding edge vertices by edge ownership (no hash map, no locks).
+// Rows are processed in parallel by z-slab; all writes land at offsets fixed by pass 2, so the mesh
+// is the same, byte for byte, for every thread count.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "core/cube.hpp"
+#include "core/decide.hpp"
+#include "core/parallel.hpp"
+#include "tables/mc33_tables.hpp"
+
+namespace cmc33 {
+namespace {
+
+using detail::kEdgeCorners;
+
+/// The sign rule for samples of type T: v >= iso. For integer types the comparison is done
+/// exactly against ceil(iso), so a uint8 sample 80 at iso 80 is above.
+template <class T> struct Above {
+    double iso;
+    explicit Above(double i) : iso(i) {}
+    bool operator()(T v) const { return static_cast<double>(v) >= iso; }
+};
+
+constexpr std::int64_t kCornerOffset[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
+                                              {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
+template <class T> class Extractor {
+public:
+    Extractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
+        : g_(g), iso_(iso), above_(iso), opt_(opt), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()),
+          threads_(detail::resolve_threads(opt.threads))
+    {
+    }
+
+    Mesh run(ExtractStats* stats)
+    {
+        const std::int64_t rows = ny_ * nz_;
+        row_vertices_.assign(static_cast<std::size_t>(rows) + 1, 0);
+        row_triangles_.assign(static_cast<std::size_t>(rows) + 1, 0);
+        decisions_.assign(static_cast<std::size_t>((nx_ - 1) * (ny_ - 1) * (nz_ - 1)), 0);
+        std::vector<ExtractStats> per_thread(static_cast<std::size_t>(threads_));
+
+        // Pass 1: classify, decide, count.
+        detail::parallel_chunks(nz_, threads_, [&](int t, std::int64_t k0, std::int64_t k1) {
+            for (std::int64_t k = k0; k < k1; ++k)
+                for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, per_thread[static_cast<std::size_t>(t)]);
+        });
+        if (stats) {
+            *stats = {};
+            for (const auto& s : per_thread)
+                for (int i = 0; i < kSubcaseCount; ++i) stats->cells_per_subcase[static_cast<std::size_t>(i)] += s.cells_per_subcase[static_cast<std::size_t>(i)];
+        }
+
+        // Pass 2: exclusive scan (row r's counts are stored at r + 1).
+        for (std::int64_t r = 0; r < rows; ++r) {
+            row_vertices_[static_cast<std::size_t>(r) + 1] += row_vertices_[static_cast<std::size_t>(r)];
+            row_triangles_[static_cast<std::size_t>(r) + 1] += row_triangles_[static_cast<std::size_t>(r)];
+        }
+        const std::int64_t nv = row_vertices_.back(), nt = row_triangles_.back();
+        if (nv > static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max())) {
+            throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
+                                               " vertices, more than 32-bit indices can address");
+        }
+        Mesh mesh;
+        mesh.positions.resize(static_cast<std::size_t>(nv) * 3);
+        if (opt_.normals) mesh.normals.resize(static_cast<std::size_t>(nv) * 3);
+        mesh.triangles.resize(static_cast<std::size_t>(nt) * 3);
+
+        // Passes 3 and 4: emit.
+        detail::parallel_chunks(nz_, threads_, [&](int, std::int64_t k0, std::int64_t k1) {
+            RowIds ids(nx_);
+            for (std::int64_t k = k0; k < k1; ++k)
+                for (std::int64_t j = 0; j < ny_; ++j) {
+                    emit_row_vertices(j, k, mesh);
+                    if (j + 1 < ny_ && k + 1 < nz_) emit_row_cells(j, k, mesh, ids);
+                }
+        });
+        return mesh;
+    }
+
+private:
+    // Vertex ids of the edges owned by one row of samples: ids[3 * i + axis], or -1.
+    struct RowIds {
+        explicit RowIds(std::int64_t nx) : rows(4, std::vector<std::int64_t>(static_cast<std::size_t>(3 * nx))) {}
+        std::vector<std::vector<std::int64_t>> rows; // rows (j,k), (j+1,k), (j,k+1), (j+1,k+1)
+    };
+
+    T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
+    std::int64_t row_index(std::int64_t j, std::int64_t k) const { return j + k * ny_; }
+    std::size_t cell_index(std::int64_t i, std::int64_t j, std::int64_t k) const
+    {
+        return static_cast<std::size_t>(i + (nx_ - 1) * (j + (ny_ - 1) * k));
+    }
+
+    /// Does the edge owned by sample (i, j, k) along `axis` cross? (It must exist.)
+    bool edge_crosses(std::int64_t i, std::int64_t j, std::int64_t k, int axis) const
+    {
+        const T a = at(i, j, k);
+        const T b = axis == 0 ? at(i + 1, j, k) : axis == 1 ? at(i, j + 1, k) : at(i, j, k + 1);
+        return above_(a) != above_(b);
+    }
+
+    unsigned case_code(std::int64_t i, std::int64_t j, std::int64_t k, double* values) const
+    {
+        unsigned code = 0;
+        for (int c = 0; c < 8; ++c) {
+            const T s = at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
+            if (values) values[c] = static_cast<double>(s) - iso_;
+            code |= static_cast<unsigned>(above_(s)) << c;
+        }
+        return code;
+    }
+
+    void count_row(std::int64_t j, std::int64_t k, ExtractStats& stats)
+    {
+        std::int64_t vertices = 0, triangles = 0;
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            if (i + 1 < nx_) vertices += edge_crosses(i, j, k, 0);
+            if (j + 1 < ny_) vertices += edge_crosses(i, j, k, 1);
+            if (k + 1 < nz_) vertices += edge_crosses(i, j, k, 2);
+        }
+        if (j + 1 < ny_ && k + 1 < nz_) {
+            double v[8];
+            for (std::int64_t i = 0; i + 1 < nx_; ++i) {
+                const unsigned code = case_code(i, j, k, v);
+                if (code == 0 || code == 255) continue;
+                const detail::Decision d = detail::decide(v, code, opt_.method);
+                const detail::Tiling& tl = d.variant->tilings[d.tiling];
+                decisions_[cell_index(i, j, k)] =
+                    static_cast<std::uint8_t>((d.variant - &detail::kVariants[detail::kVariantOffset[code]]) | d.tiling << 6);
+                vertices += tl.interior_count;
+                triangles += tl.triangle_count;
+                ++stats.cells_per_subcase[static_cast<std::size_t>(d.subcase)];
+            }
+        }
+        row_vertices_[static_cast<std::size_t>(row_index(j, k)) + 1] = vertices;
+        row_triangles_[static_cast<std::size_t>(row_index(j, k)) + 1] = triangles;
+    }
+
+    /// Crossing of the edge from sample p along axis, as (parameter in [0,1]).
+    double crossing(T a, T b) const
+    {
+        const double va = static_cast<double>(a), vb = static_cast<double>(b);
+        return std::clamp((iso_ - va) / (vb - va), 0.0, 1.0); // ends differ in sign: vb != va
+    }
+
+    std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k) const
+    {
+        std::array<double, 3> grad{};
+        const std::int64_t idx[3] = {i, j, k};
+        const std::int64_t n[3] = {nx_, ny_, nz_};
+        for (int axis = 0; axis < 3; ++axis) {
+            std::int64_t lo[3] = {i, j, k}, hi[3] = {i, j, k};
+            if (idx[axis] > 0) --lo[axis];
+            if (idx[axis] + 1 < n[axis]) ++hi[axis];
+            const double d = static_cast<double>(hi[axis] - lo[axis]) * g_.spacing[static_cast<std::size_t>(axis)];
+            grad[static_cast<std::size_t>(axis)] =
+                (static_cast<double>(at(hi[0], hi[1], hi[2])) - static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
+        }
+        return grad;
+    }
+
+    void emit_row_vertices(std::int64_t j, std::int64_t k, Mesh& mesh) const
+    {
+        std::int64_t id = row_vertices_[static_cast<std::size_t>(row_index(j, k))];
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            for (int axis = 0; axis < 3; ++axis) {
+                const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
+                if (end[0] >= nx_ || end[1] >= ny_ || end[2] >= nz_) continue;
+                const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
+                if (above_(a) == above_(b)) continue;
+                const double t = crossing(a, b);
+                const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+                float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
+                for (int c = 0; c < 3; ++c) {
+                    const double x = p[c] + (c == axis ? t : 0.0);
+                    out[c] = static_cast<float>(g_.origin[static_cast<std::size_t>(c)] + g_.spacing[static_cast<std::size_t>(c)] * x);
+                }
+                if (opt_.normals) {
+                    const auto ga = gradient(i, j, k), gb = gradient(end[0], end[1], end[2]);
+                    write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3],
+                                 {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
+                }
+                ++id;
+            }
+        }
+    }
+
+    /// Normals point from above to below: along minus the gradient.
+    static void write_normal(float* out, std::array<double, 3> g)
+    {
+        const double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        for (int c = 0; c < 3; ++c) out[c] = len > 0 ? static_cast<float>(-g[static_cast<std::size_t>(c)] / len) : 0.0f;
+    }
+
+    /// Returns the id after the row's last edge vertex: where its cells' interior vertices start.
+    std::int64_t fill_row_ids(std::int64_t j, std::int64_t k, std::vector<std::int64_t>& ids) const
+    {
+        std::int64_t id = row_vertices_[static_cast<std::size_t>(row_index(j, k))];
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            for (int axis = 0; axis < 3; ++axis) {
+                std::int64_t& slot = ids[static_cast<std::size_t>(3 * i + axis)];
+                slot = -1;
+                const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
+                if (end[0] >= nx_ || end[1] >= ny_ || end[2] >= nz_) continue;
+                if (above_(at(i, j, k)) != above_(at(end[0], end[1], end[2]))) slot = id++;
+            }
+        }
+        return id;
+    }
+
+    void emit_row_cells(std::int64_t j, std::int64_t k, Mesh& mesh, RowIds& ids) const
+    {
+        std::int64_t vertex = fill_row_ids(j, k, ids.rows[0]); // the row's interior vertices follow its edges
+        fill_row_ids(j + 1, k, ids.rows[1]);
+        fill_row_ids(j, k + 1, ids.rows[2]);
+        fill_row_ids(j + 1, k + 1, ids.rows[3]);
+        const std::int64_t r = row_index(j, k);
+        std::int64_t tri = row_triangles_[static_cast<std::size_t>(r)];
+        for (std::int64_t i = 0; i + 1 < nx_; ++i) {
+            const unsigned code = case_code(i, j, k, nullptr);
+            if (code == 0 || code == 255) continue;
+            const std::uint8_t dec = decisions_[cell_index(i, j, k)];
+            const detail::Variant& var = detail::kVariants[detail::kVariantOffset[code] + (dec & 63u)];
+            const detail::Tiling& tl = var.tilings[dec >> 6];
+            std::int64_t edge_id[12];
+            for (int e = 0; e < 12; ++e) {
+                const int c = kEdgeCorners[e][0];
+                const std::size_t row = static_cast<std::size_t>(kCornerOffset[c][1] + 2 * kCornerOffset[c][2]);
+                edge_id[e] = ids.rows[row][static_cast<std::size_t>(3 * (i + kCornerOffset[c][0]) + e / 4)];
+            }
+            const std::int64_t first_interior = vertex;
+            for (int q = 0; q < tl.interior_count; ++q) {
+                write_interior_vertex(i, j, k, detail::kInteriorMasks[tl.first_interior + q], vertex++, mesh);
+            }
+            const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3];
+            std::uint32_t* out = &mesh.triangles[static_cast<std::size_t>(tri) * 3];
+            for (int q = 0; q < 3 * tl.triangle_count; ++q) {
+                const int v = codes[q];
+                out[q] = static_cast<std::uint32_t>(v < 12 ? edge_id[v] : first_interior + (v - 12));
+            }
+            tri += tl.triangle_count;
+        }
+    }
+
+    /// An interior vertex: the mean of the crossings on the edges of `mask` (normal likewise).
+    void write_interior_vertex(std::int64_t i, std::int64_t j, std::int64_t k, unsigned mask, std::int64_t id,
+                               Mesh& mesh) const
+    {
+        double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+        int count = 0;
+        for (int e = 0; e < 12; ++e) {
+            if (!((mask >> e) & 1u)) continue;
+            const int a = kEdgeCorners[e][0], b = kEdgeCorners[e][1], axis = e / 4;
+            const std::int64_t ia[3] = {i + kCornerOffset[a][0], j + kCornerOffset[a][1], k + kCornerOffset[a][2]};
+            const std::int64_t ib[3] = {i + kCornerOffset[b][0], j + kCornerOffset[b][1], k + kCornerOffset[b][2]};
+            const double t = crossing(at(ia[0], ia[1], ia[2]), at(ib[0], ib[1], ib[2]));
+            for (int c = 0; c < 3; ++c) p[c] += static_cast<double>(ia[c]) + (c == axis ? t : 0.0);
+            if (opt_.normals) {
+                const auto ga = gradient(ia[0], ia[1], ia[2]), gb = gradient(ib[0], ib[1], ib[2]);
+                for (int c = 0; c < 3; ++c) {
+                    const std::size_t cc = static_cast<std::size_t>(c);
+                    n[c] += ga[cc] + t * (gb[cc] - ga[cc]);
+                }
+            }
+            ++count;
+        }
+        float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
+        for (int c = 0; c < 3; ++c) {
+            const std::size_t cc = static_cast<std::size_t>(c);
+            out[c] = static_cast<float>(g_.origin[cc] + g_.spacing[cc] * (p[c] / count));
+        }
+        if (opt_.normals) write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3], {n[0], n[1], n[2]});
+    }
+
+    const GridView<T>& g_;
+    double iso_;
+    Above<T> above_;
+    ExtractOptions opt_;
+    std::int64_t nx_, ny_, nz_;
+    int threads_;
+    std::vector<std::int64_t> row_vertices_, row_triangles_;
+    std::vector<std::uint8_t> decisions_;
+};
+
+template <class T> void validate(const GridView<T>& g, double iso)
+{
+    if (!std::isfinite(iso)) {
+        throw Error(Status::non_finite, "isovalue " + std::to_string(iso) + " is not a finite number");
+    }
+    for (int a = 0; a < 3; ++a) {
+        if (g.dims[static_cast<std::size_t>(a)] < 2) {
+            throw Error(Status::invalid_argument, "grid has " + std::to_string(g.dims[static_cast<std::size_t>(a)]) +
+                                                      " samples along " + "xyz"[a] +
+                                                      "; an isosurface needs at least 2 on each axis");
+        }
+    }
+    if (g.strides[0] != 1) throw Error(Status::invalid_argument, "grid view must have unit x-stride");
+    if constexpr (std::is_floating_point_v<T>) {
+        std::int64_t count = 0;
+        Index3 first{-1, -1, -1};
+        for (std::int64_t k = 0; k < g.nz(); ++k)
+            for (std::int64_t j = 0; j < g.ny(); ++j)
+                for (std::int64_t i = 0; i < g.nx(); ++i)
+                    if (!std::isfinite(g(i, j, k)) && count++ == 0) first = {i, j, k};
+        if (count > 0) {
+            throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
+                                                std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
+                                                std::to_string(first[2]) + "); cmc33 needs finite samples");
+        }
+    }
+}
+
+} // namespace
+
+template <class T> Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
+{
+    validate(grid, iso);
+    return Extractor<T>(grid, iso, options).run(stats);
+}
+
+Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, ExtractStats* stats)
+{
+    return volume.visit([&](auto view) { return extract(view, iso, options, stats); });
+}
+
+#define CMC33_INSTANTIATE(T) \
+    template Mesh extract<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);
+CMC33_INSTANTIATE(std::int8_t)
+CMC33_INSTANTIATE(std::uint8_t)
+CMC33_INSTANTIATE(std::int16_t)
+CMC33_INSTANTIATE(std::uint16_t)
+CMC33_INSTANTIATE(std::int32_t)
+CMC33_INSTANTIATE(std::uint32_t)
+CMC33_INSTANTIATE(float)
+CMC33_INSTANTIATE(double)
+#undef CMC33_INSTANTIATE
+
+} // namespace cmc33

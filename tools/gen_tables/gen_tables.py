@@ -1,0 +1,434 @@
+#!/usr/bin/env python3
+"""Generates src/tables/mc33_tables.cpp: the Marching Cubes 33 triangulations of every
+(sign configuration, face decisions, interior decision), from first principles.
+
+How (design.md, "Tables"):
+ 1. Face decisions give the boundary loops of the surface on the cell's faces (loops.py).
+ 2. The subcase follows from the base case (orbit of the configuration under the 24 rotations and
+    complement) and the loops; Chernyaev's numbering (Chernyaev 1995; Custodio et al. 2013, Sec. 3).
+ 3. Subcases with an interior ambiguity (4.1, 6.1, 7.4, 10.1, 12.1, 13.5) get a second (and for
+    13.5 a third) tiling in which one pair of loops is joined by a tube. The interior test that
+    chooses between them is set up here (axis, tested diagonal) and evaluated at run time.
+ 4. A loop becomes a disc: a polygon triangulation that never puts a triangle edge inside a cell
+    face unless it is one of that face's arcs (two cells sharing a face would otherwise share the
+    chord: the non-manifold edges of Custodio et al. Sec. 5.2), or, when no such triangulation exists
+    or the loop is long, a fan around an interior vertex. A tube runs through a ring of interior
+    vertices, so it never touches a face either.
+ 5. Every tiling is checked: crossing vertices only on crossed edges, boundary = the face arcs each
+    used once in loop direction, every inner edge used twice in opposite directions, no face chord.
+Run: python3 tools/gen_tables/gen_tables.py > src/tables/mc33_tables.cpp  (a test checks it is current)
+"""
+import math
+import sys
+import os
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from cube import (EDGE_CORNERS, ROTATIONS, ambiguous_faces, corner_pos, edge_faces, face_cycle,
+                  map_config, map_face)
+from loops import edge_mid, loops, regions
+
+SUBCASES = ["0", "1", "2", "3.1", "3.2", "4.1.1", "4.1.2", "5", "6.1.1", "6.1.2", "6.2", "7.1",
+            "7.2", "7.3", "7.4.1", "7.4.2", "8", "9", "10.1.1", "10.1.2", "10.2", "11", "12.1.1",
+            "12.1.2", "12.2", "12.3", "13.1", "13.2", "13.3", "13.4", "13.5.1", "13.5.2", "14"]
+SUB = {name: i for i, name in enumerate(SUBCASES)}
+
+# Base cases: one representative configuration (set of above corners) per orbit under rotations
+# and complement. 11 and 14 are mirror images; we call the chain 0-1-3-4 case 11.
+BASE_REPS = {0: [], 1: [0], 2: [0, 1], 3: [1, 2], 4: [3, 4], 5: [0, 1, 2], 6: [0, 3, 4],
+             7: [1, 2, 4], 8: [0, 1, 2, 3], 9: [0, 1, 2, 4], 10: [2, 3, 4, 5], 11: [0, 1, 3, 4],
+             12: [1, 2, 3, 4], 13: [0, 3, 5, 6], 14: [0, 2, 3, 4]}
+
+TEST_NONE, TEST_TUNNEL, TEST_13_5 = 0, 1, 2
+
+
+def cfg(corners):
+    return sum(1 << c for c in corners)
+
+
+def orbit(config):
+    out = set()
+    for cc in (config, (~config) & 255):
+        for r in ROTATIONS:
+            out.add(map_config(r, cc))
+    return out
+
+
+BASE_OF = {}
+for base, corners in BASE_REPS.items():
+    for c in orbit(cfg(corners)):
+        assert c not in BASE_OF, "base case orbits overlap"
+        BASE_OF[c] = base
+assert len(BASE_OF) == 256
+
+
+def map_state(rot, complement, config, joined):
+    amb = sum(1 << f for f in ambiguous_faces(config))
+    if complement:
+        config, joined = (~config) & 255, joined ^ amb
+    jm = 0
+    for f in range(6):
+        if (joined >> f) & 1:
+            jm |= 1 << map_face(rot, f)
+    return map_config(rot, config), jm
+
+
+def same_orbit(state, canonical):
+    return any(map_state(r, comp, *state) == canonical for r in ROTATIONS for comp in (False, True))
+
+
+def minority_joined(config, joined):
+    """Ambiguous faces on which the minority sign's corners are joined."""
+    above_minority = bin(config).count("1") <= 4
+    amb = ambiguous_faces(config)
+    return sum(1 for f in amb if bool((joined >> f) & 1) == above_minority)
+
+
+def label(config, joined, ls):
+    base = BASE_OF[config]
+    sizes = sorted(len(l) for l in ls)
+    k = sum(1 for f in range(6) if (joined >> f) & 1)
+    if base in (0, 1, 2, 5, 8, 9, 11, 14):
+        return {0: "0", 1: "1", 2: "2", 5: "5", 8: "8", 9: "9", 11: "11", 14: "14"}[base]
+    if base == 3:
+        return "3.1" if sizes == [3, 3] else "3.2"
+    if base == 4:
+        return "4.1"
+    if base == 6:
+        return "6.1" if sizes == [3, 4] else "6.2"
+    if base == 7:
+        return {0: "7.1", 1: "7.2", 2: "7.3", 3: "7.4"}[minority_joined(config, joined)]
+    if base == 10:
+        return "10.1" if sizes == [4, 4] else "10.2"
+    if base == 12:
+        if sizes == [3, 5]:
+            return "12.1"
+        return "12.2" if same_orbit((config, joined), (cfg([1, 2, 3, 4]), 1 << 0)) else "12.3"
+    assert base == 13
+    if sizes == [3, 3, 3, 3]:
+        return "13.1"
+    if sizes == [3, 3, 6]:
+        return "13.5" if k == 3 else "13.2"
+    if sizes == [3, 9]:
+        return "13.3"
+    if sizes == [6, 6]:
+        return "13.3"  # opposite faces joined: not realisable by a trilinear function
+    assert sizes == [12]
+    return "13.4"      # includes the two 'strip' patterns, also not realisable
+
+
+# ---------------------------------------------------------------- interior test set-up
+
+def loop_regions(config, joined, ls):
+    """For each loop, the two regions (indices into regions()) on its sides."""
+    regs = regions(config, joined)
+    out = []
+    for l in ls:
+        sides = set()
+        for e, _ in l:
+            a, b = EDGE_CORNERS[e]
+            sides.add(next(i for i, r in enumerate(regs) if a in r))
+            sides.add(next(i for i, r in enumerate(regs) if b in r))
+        assert len(sides) == 2
+        out.append(sides)
+    return regs, out
+
+
+def tube_pairs(config, joined, ls):
+    """Pairs of loops that a tube could join: loops sharing a side region; the tube then joins
+    their two other regions. Returns (i, j, region_i, region_j)."""
+    regs, sides = loop_regions(config, joined, ls)
+    out = []
+    for i in range(len(ls)):
+        for j in range(i + 1, len(ls)):
+            common = sides[i] & sides[j]
+            if len(common) == 1:
+                (ri,) = sides[i] - common
+                (rj,) = sides[j] - common
+                out.append((i, j, regs[ri], regs[rj]))
+    return out
+
+
+def diagonal_between(ra, rb):
+    """The end, in the smaller region, of a cube diagonal joining regions ra and rb. The test
+    sweeps from that corner's face: for 7.4 it is the isolated corner, whose edges all cross."""
+    if (len(rb), min(rb)) < (len(ra), min(ra)):
+        ra, rb = rb, ra
+    for p in sorted(ra):
+        if (p ^ 7) in rb:
+            return p
+    raise AssertionError("no diagonal joins the two regions")
+
+
+def test_axis(base, config):
+    amb = ambiguous_faces(config)
+    if base in (4, 7):
+        return 2
+    if base == 6:
+        return amb[0] // 2
+    if base == 10:
+        return amb[0] // 2
+    if base == 12:
+        return ({0, 1, 2} - {f // 2 for f in amb}).pop()
+    raise AssertionError(base)
+
+
+def bottom_end(p, axis):
+    """Of the diagonal (p, p^7), the corner on the side axis = 0."""
+    return p if not (p >> axis) & 1 else p ^ 7
+
+
+# ---------------------------------------------------------------- triangulation
+
+def share_face(e1, e2):
+    return bool(set(edge_faces(e1)) & set(edge_faces(e2)))
+
+
+def dist(p, q):
+    return math.sqrt(sum((p[i] - q[i]) ** 2 for i in range(3)))
+
+
+def disc(loop, interior):
+    """Triangles (vertex codes) of a disc bounded by `loop` (edge list in boundary order).
+    `interior` collects interior vertices as edge masks; codes 12+k refer to them."""
+    m = len(loop)
+    if m == 3:
+        return [tuple(loop)]
+    seg = {(loop[i], loop[(i + 1) % m]) for i in range(m)}
+    ok = lambda a, b: (a, b) in seg or (b, a) in seg or not share_face(a, b)
+    if m <= 6:
+        # minimum total chord length triangulation among those with no face chord (O(m^3) DP)
+        inf = float("inf")
+        best = {}
+        for span in range(1, m):
+            for i in range(0, m - span):
+                j = i + span
+                if span == 1:
+                    best[i, j] = (0.0, [])
+                    continue
+                cand = (inf, None)
+                if ok(loop[i], loop[j]) or (i == 0 and j == m - 1):
+                    for k in range(i + 1, j):
+                        if not (ok(loop[i], loop[k]) and ok(loop[k], loop[j])):
+                            continue
+                        cost = best[i, k][0] + best[k, j][0]
+                        cost += dist(edge_mid(loop[i]), edge_mid(loop[k])) if k - i > 1 else 0
+                        cost += dist(edge_mid(loop[k]), edge_mid(loop[j])) if j - k > 1 else 0
+                        if cost < cand[0] and best[i, k][1] is not None and best[k, j][1] is not None:
+                            cand = (cost, best[i, k][1] + best[k, j][1] + [(loop[i], loop[k], loop[j])])
+                best[i, j] = cand
+        if best[0, m - 1][1] is not None:
+            return best[0, m - 1][1]
+    mask = sum(1 << e for e in loop)
+    interior.append(mask)
+    c = 12 + len(interior) - 1
+    return [(c, loop[i], loop[(i + 1) % m]) for i in range(m)]
+
+
+def tube(outer, inner_loop, interior):
+    """An annulus between loop `outer` and loop `inner_loop` (both in boundary order) through a
+    ring of interior vertices, one per vertex of `outer`, each the midpoint of that vertex and the
+    nearest-aligned vertex of the other loop."""
+    m, inner = len(outer), list(reversed(inner_loop))
+    n = len(inner)
+    best = None
+    for s in range(n):
+        cost = sum(dist(edge_mid(outer[i]), edge_mid(inner[(s + round(i * n / m)) % n])) for i in range(m))
+        if best is None or cost < best[0] - 1e-12:
+            best = (cost, s)
+    s = best[1]
+    ring = []
+    for i in range(m):
+        interior.append((1 << outer[i]) | (1 << inner[(s + round(i * n / m)) % n]))
+        ring.append(12 + len(interior) - 1)
+    tris = []
+    for i in range(m):
+        a, a1, r, r1 = outer[i], outer[(i + 1) % m], ring[i], ring[(i + 1) % m]
+        tris += [(a, a1, r), (r, a1, r1)]
+    # band between the ring (outer side) and the inner loop, walked together once around
+    inner = inner[s:] + inner[:s]
+    i = j = 0
+    while i < m or j < n:
+        if j >= n or (i < m and (i + 1) / m <= (j + 1) / n):
+            tris.append((ring[i % m], ring[(i + 1) % m], inner[j % n]))
+            i += 1
+        else:
+            tris.append((inner[j % n], ring[i % m], inner[(j + 1) % n]))
+            j += 1
+    return tris
+
+
+def tiling(ls, joined_pair=None):
+    interior, tris = [], []
+    edges = [[e for e, _ in l] for l in ls]
+    for idx, l in enumerate(edges):
+        if joined_pair and idx in joined_pair:
+            continue
+        tris += disc(l, interior)
+    if joined_pair:
+        tris += tube(edges[joined_pair[0]], edges[joined_pair[1]], interior)
+    return tris, interior
+
+
+def check_tiling(config, ls, tris, interior, context):
+    crossed = {e for e in range(12) if ((config >> EDGE_CORNERS[e][0]) & 1) != ((config >> EDGE_CORNERS[e][1]) & 1)}
+    directed = {}
+    for t in tris:
+        assert len(set(t)) == 3, context
+        for v in t:
+            assert v >= 12 or v in crossed, context
+            assert v < 12 + len(interior), context
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            assert (a, b) not in directed, ("edge used twice in one direction", context)
+            directed[a, b] = True
+            if a < 12 and b < 12 and share_face(a, b):
+                on_arc = any((a, b) == (l[i][0], l[(i + 1) % len(l)][0]) for l in ls for i in range(len(l)))
+                assert on_arc, ("triangle edge inside a face is not a face arc", context, a, b)
+    arcs = {(l[i][0], l[(i + 1) % len(l)][0]) for l in ls for i in range(len(l))}
+    for (a, b) in directed:
+        if (b, a) not in directed:
+            assert (a, b) in arcs, ("boundary edge that is not an arc", context, a, b)
+    for arc in arcs:
+        assert arc in directed and (arc[1], arc[0]) not in directed, ("arc not used once", context, arc)
+    for m in interior:
+        assert m and all(((m >> e) & 1) == 0 or e in crossed for e in range(12)), context
+
+
+def self_test_orientation():
+    """One corner above: the normal of its triangle must point away from that corner."""
+    ls = loops(1, 0)
+    (a, b, c), = tiling(ls)[0]
+    pa, pb, pc = edge_mid(a), edge_mid(b), edge_mid(c)
+    u = [pb[i] - pa[i] for i in range(3)]
+    v = [pc[i] - pa[i] for i in range(3)]
+    n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    assert sum(n[i] * pa[i] for i in range(3)) > 0, "orientation rule broken"
+
+
+# ---------------------------------------------------------------- the variant table
+
+def variants():
+    out = []  # per config: list of dicts, indexed by compact face bits
+    for config in range(256):
+        amb = ambiguous_faces(config)
+        base = BASE_OF[config]
+        per = []
+        for bits in range(1 << len(amb)):
+            joined = sum(1 << f for i, f in enumerate(amb) if (bits >> i) & 1)
+            ls = loops(config, joined)
+            name = label(config, joined, ls)
+            v = {"config": config, "joined": joined, "base": base, "test": TEST_NONE,
+                 "axis": 0, "corner": 0, "lw_axis": 0, "lw_corner": 0, "lw_edge": 0,
+                 "lewiner_skips": 0, "tilings": [tiling(ls)]}
+            v["subcase"] = SUB[name] if name in SUB else SUB[name + ".1"]
+            if name in ("4.1", "6.1", "7.4", "10.1", "12.1"):
+                (i, j, ri, rj), = tube_pairs(config, joined, ls)
+                p = diagonal_between(ri, rj)
+                axis = test_axis(base, config)
+                v.update(test=TEST_TUNNEL, axis=axis, corner=p)
+                v["tunnel_subcase"] = SUB[name + ".2"]
+                v["tilings"].append(tiling(ls, (i, j)))
+                # mc33-lewiner: t_alt from the first crossed edge among P->P^u, P->P^v, P->P^w
+                P = v["corner"]
+                u, w_ = [a for a in range(3) if a != axis]
+                for q in (P ^ (1 << u), P ^ (1 << w_), P ^ (1 << axis)):
+                    if ((config >> P) & 1) != ((config >> q) & 1):
+                        v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {P, q}][0]
+                        break
+                else:
+                    raise AssertionError("no reference edge")
+                v["lw_axis"], v["lw_corner"] = axis, P
+                # the branch of cases 10 and 12 that Lewiner et al.'s implementation misses: the
+                # minority... for these 4-corner cases: the above corners joined on the faces
+                if base in (10, 12) and all((joined >> f) & 1 for f in amb):
+                    v["lewiner_skips"] = 1
+            elif name == "13.5":
+                regs = regions(config, joined)
+                # the two corners isolated on all their faces: a cap each; they form a diagonal
+                caps = [r for r in regs if len(r) == 1]
+                (s_plus,) = [next(iter(r)) for r in caps if (config >> next(iter(r))) & 1]
+                (s_minus,) = [next(iter(r)) for r in caps if not (config >> next(iter(r))) & 1]
+                assert s_plus ^ s_minus == 7
+                v.update(test=TEST_13_5, axis=2, corner=bottom_end(s_plus, 2))
+                v["tunnel_subcase"] = SUB["13.5.2"]
+                cap_loop = lambda corner: next(i for i, l in enumerate(ls) if all(corner in EDGE_CORNERS[e] for e, _ in l))
+                hexa = next(i for i, l in enumerate(ls) if len(l) == 6)
+                v["tilings"].append(tiling(ls, (cap_loop(s_plus), hexa)))   # tunnel faces s_plus
+                v["tilings"].append(tiling(ls, (cap_loop(s_minus), hexa)))  # tunnel faces s_minus
+                # Lewiner's route (Custodio et al., Appendix A): along x, from the x-neighbour of
+                # s_minus to s_minus, t_alt where the field crosses that edge
+                v["lw_axis"], v["lw_corner"] = 0, s_minus ^ 1
+                v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {s_minus, s_minus ^ 1}][0]
+            for t, (tris, interior) in enumerate(v["tilings"]):
+                check_tiling(config, ls, tris, interior, (config, joined, name, t))
+            per.append(v)
+        out.append(per)
+    return out
+
+
+def emit(table):
+    tri_codes, interior_masks, rows, offsets = [], [], [], [0]
+    for per in table:
+        for v in per:
+            tl = []
+            for tris, interior in v["tilings"]:
+                tl.append((len(tris), len(interior), len(tri_codes) // 3, len(interior_masks)))
+                for t in tris:
+                    tri_codes.extend(t)
+                interior_masks.extend(interior)
+            while len(tl) < 3:
+                tl.append((0, 0, 0, 0))
+            rows.append((v, tl))
+        offsets.append(offsets[-1] + len(per))
+    p = print
+    p("// GENERATED by tools/gen_tables/gen_tables.py. Do not edit: change the generator and run")
+    p("//   python3 tools/gen_tables/gen_tables.py > src/tables/mc33_tables.cpp")
+    p("// Numbering: src/core/cube.hpp. Layout: src/tables/mc33_tables.hpp.")
+    p('#include "tables/mc33_tables.hpp"')
+    p("")
+    p("namespace cmc33::detail {")
+    p("")
+    p("const std::uint8_t kAmbiguousFaces[256] = {")
+    vals = [sum(1 << f for f in ambiguous_faces(c)) for c in range(256)]
+    for i in range(0, 256, 16):
+        p("    " + ", ".join(str(x) for x in vals[i:i + 16]) + ",")
+    p("};")
+    p("")
+    p("const std::uint8_t kBaseCase[256] = {")
+    for i in range(0, 256, 16):
+        p("    " + ", ".join(str(BASE_OF[c]) for c in range(i, i + 16)) + ",")
+    p("};")
+    p("")
+    p("const std::uint16_t kVariantOffset[257] = {")
+    for i in range(0, 257, 16):
+        p("    " + ", ".join(str(x) for x in offsets[i:i + 16]) + ",")
+    p("};")
+    p("")
+    p(f"const Variant kVariants[{len(rows)}] = {{")
+    p("    // subcase, tunnel_subcase, test, axis, corner, lw_axis, lw_corner, lw_edge, lewiner_skips,")
+    p("    // tilings {triangles, interior vertices, first triangle, first interior}   config/joined faces")
+    for v, tl in rows:
+        t = ", ".join("{%d, %d, %d, %d}" % x for x in tl)
+        p("    {%d, %d, %d, %d, %d, %d, %d, %d, %d, {%s}}, // %d/%s %s" % (
+            v["subcase"], v.get("tunnel_subcase", v["subcase"]), v["test"], v["axis"], v["corner"],
+            v["lw_axis"], v["lw_corner"], v["lw_edge"], v["lewiner_skips"], t, v["config"],
+            "".join(str(f) for f in range(6) if (v["joined"] >> f) & 1) or "-", SUBCASES[v["subcase"]]))
+    p("};")
+    p("")
+    p(f"const std::uint8_t kTriangleCodes[{len(tri_codes)}] = {{")
+    for i in range(0, len(tri_codes), 24):
+        p("    " + ", ".join(str(x) for x in tri_codes[i:i + 24]) + ",")
+    p("};")
+    p("")
+    p(f"const std::uint16_t kInteriorMasks[{len(interior_masks)}] = {{")
+    for i in range(0, len(interior_masks), 16):
+        p("    " + ", ".join(str(x) for x in interior_masks[i:i + 16]) + ",")
+    p("};")
+    p("")
+    p("} // namespace cmc33::detail")
+    return len(rows), len(tri_codes) // 3, len(interior_masks)
+
+
+if __name__ == "__main__":
+    self_test_orientation()
+    stats = emit(variants())
+    print("gen_tables: %d variants, %d triangles, %d interior vertices" % stats, file=sys.stderr)
