@@ -30,13 +30,27 @@ inline bool face_joined(const double* v, int f, double* saddle = nullptr)
     return A >= 0 ? num >= 0 : num <= 0;
 }
 
+/// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
+/// run on these with every value v - iso given as (v - iso) + eps: that is the level set at
+/// iso - eps, exactly the sign rule, so exact ties (integer data at an integer isovalue) are decided
+/// as the verifier sees them. Products drop eps^2: F's eps^2 terms cancel, and t_max is linear in eps.
+struct Eps {
+    double x = 0, y = 0;
+    friend Eps operator+(Eps a, Eps b) { return {a.x + b.x, a.y + b.y}; }
+    friend Eps operator-(Eps a, Eps b) { return {a.x - b.x, a.y - b.y}; }
+    friend Eps operator*(Eps a, Eps b) { return {a.x * b.x, a.x * b.y + a.y * b.x}; }
+    friend Eps operator*(double k, Eps a) { return {k * a.x, k * a.y}; }
+    int sign() const { return x > 0 ? 1 : x < 0 ? -1 : y > 0 ? 1 : y < 0 ? -1 : 0; }
+    bool above() const { return sign() >= 0; } // the sign rule: zero counts as above
+};
+
 /// The sweep of Chernyaev's interior test: planes perpendicular to `axis`, from the face holding
 /// corner P (A0) to the opposite face. A, B, C, D are the four edges along the axis, A through P,
 /// C through the corner diagonal to P on that face, so that C1 = P ^ 7.
-struct Sweep {
-    double A0, B0, C0, D0, A1, B1, C1, D1;
+template <class Num> struct SweepT {
+    Num A0, B0, C0, D0, A1, B1, C1, D1;
 
-    Sweep(const double* v, int axis, int P)
+    SweepT(const Num* v, int axis, int P)
     {
         const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
         const int p[4] = {P, flip(P, u), flip(flip(P, u), w), flip(P, w)};
@@ -44,62 +58,86 @@ struct Sweep {
         A1 = v[flip(p[0], axis)], B1 = v[flip(p[1], axis)], C1 = v[flip(p[2], axis)], D1 = v[flip(p[3], axis)];
     }
     // F(t) = A_t C_t - B_t D_t = a t^2 + b t + c   (Custodio et al. 2013, Eqs. 6-7, Appendix A)
-    double a() const { return (A1 - A0) * (C1 - C0) - (B1 - B0) * (D1 - D0); }
-    double b() const { return C0 * (A1 - A0) + A0 * (C1 - C0) - D0 * (B1 - B0) - B0 * (D1 - D0); }
-    double c() const { return A0 * C0 - B0 * D0; }
-    double F(double t) const { return at(A0, A1, t) * at(C0, C1, t) - at(B0, B1, t) * at(D0, D1, t); }
-    static double at(double x0, double x1, double t) { return x0 + (x1 - x0) * t; }
-
-    /// In the slice at height t, is the region of corner A joined to that of corner C? Both must
-    /// have A0's sign; through B or D when one of them has it too, else by the slice's saddle
-    /// (asymptotic decider, sign rule: a saddle equal to iso is above).
-    bool slice_joins(double t) const
-    {
-        const bool s = A0 >= 0;
-        const double a_t = at(A0, A1, t), b_t = at(B0, B1, t), c_t = at(C0, C1, t), d_t = at(D0, D1, t);
-        if ((a_t >= 0) != s || (c_t >= 0) != s) return false;
-        if ((b_t >= 0) == s || (d_t >= 0) == s) return true;
-        const double num = a_t * c_t - b_t * d_t;
-        return s ? num >= 0 : num > 0;
-    }
-    /// Saddle position (u along A->B, v along A->D) of the slice at t (Custodio et al., Eq. 9).
-    bool saddle_inside(double t, std::array<double, 2>* where) const
-    {
-        const double a_t = at(A0, A1, t), b_t = at(B0, B1, t), c_t = at(C0, C1, t), d_t = at(D0, D1, t);
-        const double den = a_t + c_t - b_t - d_t;
-        if (den == 0) return false;
-        const double u = (a_t - d_t) / den, v = (a_t - b_t) / den;
-        if (where) *where = {u, v};
-        return u > 0 && u < 1 && v > 0 && v < 1;
-    }
+    Num a() const { return (A1 - A0) * (C1 - C0) - (B1 - B0) * (D1 - D0); }
+    Num b() const { return C0 * (A1 - A0) + A0 * (C1 - C0) - D0 * (B1 - B0) - B0 * (D1 - D0); }
+    Num c() const { return A0 * C0 - B0 * D0; }
+    static Num at(Num x0, Num x1, Num t) { return x0 + (x1 - x0) * t; }
+    Num F(Num t) const { return at(A0, A1, t) * at(C0, C1, t) - at(B0, B1, t) * at(D0, D1, t); }
+    Num den(Num t) const { return at(A0, A1, t) + at(C0, C1, t) - at(B0, B1, t) - at(D0, D1, t); }
 };
+using Sweep = SweepT<double>;
+using SweepEps = SweepT<Eps>;
+
+inline int sign_of(double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; }
+inline int sign_of(const Eps& v) { return v.sign(); }
+
+/// In the slice at height t, is the region of corner A joined to that of corner C? Both must have
+/// A0's sign; through B or D when one of them has it too, else by the slice's saddle (asymptotic
+/// decider; a saddle equal to iso is above).
+inline bool slice_joins(const SweepEps& s, Eps t)
+{
+    const bool above = s.A0.above();
+    const Eps a_t = SweepEps::at(s.A0, s.A1, t), b_t = SweepEps::at(s.B0, s.B1, t);
+    const Eps c_t = SweepEps::at(s.C0, s.C1, t), d_t = SweepEps::at(s.D0, s.D1, t);
+    if (a_t.above() != above || c_t.above() != above) return false;
+    if (b_t.above() == above || d_t.above() == above) return true;
+    const int num = (a_t * c_t - b_t * d_t).sign();
+    return above ? num >= 0 : num > 0;
+}
+
+/// Is the slice saddle at t (Custodio et al., Eq. 9: u along A->B, v along A->D) inside the face?
+inline bool saddle_inside(const SweepEps& s, Eps t)
+{
+    const Eps a_t = SweepEps::at(s.A0, s.A1, t), b_t = SweepEps::at(s.B0, s.B1, t);
+    const Eps d_t = SweepEps::at(s.D0, s.D1, t);
+    const Eps den = s.den(t);
+    const int sd = den.sign();
+    if (sd == 0) return false;
+    // 0 < n / den < 1  <=>  n and den - n both have den's sign
+    const Eps nu = a_t - d_t, nv = a_t - b_t;
+    return nu.sign() == sd && (den - nu).sign() == sd && nv.sign() == sd && (den - nv).sign() == sd;
+}
 
 /// Chernyaev's test (Custodio et al. 2013, Sec. 3.1): joined iff a < 0, t_max = -b/2a in (0, 1)
 /// and the slice at t_max joins A and C (for the tunnel cases the slice's own sign pattern is read,
 /// so condition (iii) F(t_max) > 0 becomes "the slice joins them").
-inline bool chernyaev_joined(const Sweep& s, InteriorReport* r)
+inline bool chernyaev_joined(const SweepEps& s)
 {
-    const double a = s.a(), b = s.b();
-    const double t_max = a != 0 ? -b / (2 * a) : kNaN;
-    if (r) {
-        r->a = a, r->b = b, r->c = s.c(), r->t_max = t_max;
-        r->f_t_max = a != 0 ? s.F(t_max) : kNaN;
-    }
-    return a < 0 && t_max > 0 && t_max < 1 && s.slice_joins(t_max);
+    const Eps a = s.a(), b = s.b(); // a carries no eps: it is made of differences
+    if (!(a.x < 0)) return false;
+    const Eps t_max = (-0.5 / a.x) * b;
+    return t_max.sign() > 0 && (Eps{1, 0} - t_max).sign() > 0 && slice_joins(s, t_max);
 }
 
-inline void roots(const Sweep& s, double* t1, double* t2)
+/// Algorithm 1 (Custodio et al. 2013, Sec. 6.1): 13.5.2 iff both roots t1, t2 of F lie in (0, 1)
+/// and both slice saddles x_c(t1), x_c(t2) lie inside the face. Returns 0 for 13.5.1, else the
+/// sign (+1, -1) of the slice saddle at (t1 + t2) / 2: the tunnel faces the isolated corner of
+/// that sign (Sec. 6.1.1).
+inline int algorithm1(const SweepEps& s)
 {
-    const double a = s.a(), b = s.b(), c = s.c();
-    const double disc = b * b - 4 * a * c;
-    if (a == 0 || disc < 0) {
-        *t1 = *t2 = kNaN;
-        return;
+    const Eps a = s.a(), b = s.b(), c = s.c();
+    if (a.x == 0) return 0; // F is at most linear: one root
+    const Eps disc = b * b - 4.0 * (a * c);
+    Eps t1, t2;
+    if (disc.x > 0) {
+        const double r = std::sqrt(disc.x);
+        const Eps root{r, disc.y / (2 * r)};
+        t1 = (0.5 / a.x) * (Eps{0, 0} - b - root);
+        t2 = (0.5 / a.x) * (Eps{0, 0} - b + root);
+    } else if (disc.x == 0 && disc.y > 0) {
+        // a double root split by sqrt(eps): both roots sit at t0 up to sqrt(eps), which dominates
+        // eps, so "inside" is decided by t0 alone and must be strict.
+        const Eps t0 = (-0.5 / a.x) * b;
+        if (!(t0.x > 0 && t0.x < 1)) return 0;
+        t1 = t2 = Eps{t0.x, 0};
+    } else {
+        return 0;
     }
-    const double q = -0.5 * (b + std::copysign(std::sqrt(disc), b)); // stable quadratic roots
-    double r1 = q / a, r2 = q != 0 ? c / q : r1;
-    if (r1 > r2) std::swap(r1, r2);
-    *t1 = r1, *t2 = r2;
+    const auto inside = [&](Eps t) { return t.sign() > 0 && (Eps{1, 0} - t).sign() > 0 && saddle_inside(s, t); };
+    if (!inside(t1) || !inside(t2)) return 0;
+    const Eps tm = 0.5 * (t1 + t2);
+    const int saddle = s.F(tm).sign() * s.den(tm).sign();
+    return saddle >= 0 ? 1 : -1;
 }
 
 /// Lewiner et al.'s height: where the field crosses the reference edge (Custodio et al., Eq. 8).
@@ -108,6 +146,35 @@ inline double t_alt(const double* v, int edge)
     const double v0 = v[kEdgeCorners[edge][0]], v1 = v[kEdgeCorners[edge][1]];
     const double t = v0 / (v0 - v1);
     return t;
+}
+
+/// The numbers `cmc33 cell` shows (plain values, without the eps of the decisions).
+inline void report_numbers(const Sweep& s, const Sweep& lewiner, double t_lewiner, const Variant& var, InteriorReport& r)
+{
+    r.tested = true;
+    r.test = var.test == kTestTunnel ? "tunnel" : "13.5";
+    r.axis = var.axis, r.corner_a = var.corner, r.corner_c = var.corner ^ 7;
+    r.lewiner_axis = var.lewiner_axis, r.lewiner_corner = var.lewiner_corner, r.lewiner_edge = var.lewiner_edge;
+    r.a = s.a(), r.b = s.b(), r.c = s.c();
+    r.t_max = r.a != 0 ? -r.b / (2 * r.a) : kNaN;
+    r.f_t_max = r.a != 0 ? s.F(r.t_max) : kNaN;
+    r.t_alt = t_lewiner;
+    r.f_t_alt = lewiner.F(t_lewiner);
+    r.t1 = r.t2 = kNaN;
+    const double disc = r.b * r.b - 4 * r.a * r.c;
+    if (r.a != 0 && disc >= 0) {
+        const double q = -0.5 * (r.b + std::copysign(std::sqrt(disc), r.b)); // stable roots
+        double t1 = q / r.a, t2 = q != 0 ? r.c / q : t1;
+        if (t1 > t2) std::swap(t1, t2);
+        r.t1 = t1, r.t2 = t2;
+    }
+    const auto saddle = [&](double t) -> std::array<double, 2> {
+        if (std::isnan(t)) return {kNaN, kNaN};
+        const double a_t = Sweep::at(s.A0, s.A1, t), b_t = Sweep::at(s.B0, s.B1, t), d_t = Sweep::at(s.D0, s.D1, t);
+        const double den = s.den(t);
+        return {(a_t - d_t) / den, (a_t - b_t) / den};
+    };
+    r.saddle1 = saddle(r.t1), r.saddle2 = saddle(r.t2);
 }
 
 struct Decision {
@@ -140,61 +207,41 @@ inline Decision decide(const double* v, unsigned config, Method method, CellRepo
     if (var->test == kTestNone || method == Method::mc) return d;
 
     InteriorReport* r = report ? &report->interior : nullptr;
-    const Sweep sweep(v, var->axis, var->corner);
+    Eps ve[8];
+    for (int q = 0; q < 8; ++q) ve[q] = {v[q], 1.0};
+    const SweepEps sweep(ve, var->axis, var->corner);
     const Sweep lewiner(v, var->lewiner_axis, var->lewiner_corner);
-    if (r) {
-        r->tested = true;
-        r->test = var->test == kTestTunnel ? "tunnel" : "13.5";
-        r->axis = var->axis, r->corner_a = var->corner, r->corner_c = var->corner ^ 7;
-        r->lewiner_axis = var->lewiner_axis, r->lewiner_corner = var->lewiner_corner;
-        r->lewiner_edge = var->lewiner_edge;
-        r->t_alt = t_alt(v, var->lewiner_edge);
-        r->f_t_alt = lewiner.F(r->t_alt);
-        roots(sweep, &r->t1, &r->t2);
-    }
-    const bool chernyaev = chernyaev_joined(sweep, r); // fills a, b, c, t_max for the report
+    const double t_lewiner = t_alt(v, var->lewiner_edge);
+    if (r) report_numbers(Sweep(v, var->axis, var->corner), lewiner, t_lewiner, *var, *r);
     const int base = kBaseCase[config];
     bool tunnel = false;
     int tiling = 1;
     if (var->test == kTestTunnel) {
         if (method == Method::cmc33 || base == 4 || base == 10) {
-            tunnel = chernyaev;
+            tunnel = chernyaev_joined(sweep);
         } else {
-            tunnel = lewiner.slice_joins(t_alt(v, var->lewiner_edge)); // 6, 7, 12: Lewiner's t_alt
+            // 6, 7, 12 in mc33-lewiner: the slice at Lewiner's t_alt instead of t_max
+            const SweepEps lw(ve, var->lewiner_axis, var->lewiner_corner);
+            tunnel = slice_joins(lw, Eps{t_lewiner, 0});
         }
         if (method == Method::mc33_lewiner && var->lewiner_skips) {
             tunnel = false; // cases 10 and 12 with both faces joined: never tested (Sec. 5.4)
             if (r) r->skipped = true;
         }
     } else if (method == Method::cmc33) {
-        // Algorithm 1 (Custodio et al. 2013, Sec. 6.1): both roots of F in (0,1) and both slice
-        // saddles x_c(t1), x_c(t2) inside the face. Orientation (Sec. 6.1.1): the tunnel faces
-        // the corner of the isolated diagonal whose sign the slice saddle has at (t1 + t2) / 2.
-        double t1, t2;
-        roots(sweep, &t1, &t2);
-        std::array<double, 2> x1{kNaN, kNaN}, x2{kNaN, kNaN};
-        const bool in1 = t1 > 0 && t1 < 1 && sweep.saddle_inside(t1, &x1);
-        const bool in2 = t2 > 0 && t2 < 1 && sweep.saddle_inside(t2, &x2);
-        if (r) r->saddle1 = x1, r->saddle2 = x2;
-        tunnel = in1 && in2;
-        if (tunnel) {
-            const double tm = 0.5 * (t1 + t2);
-            const double a_t = Sweep::at(sweep.A0, sweep.A1, tm), b_t = Sweep::at(sweep.B0, sweep.B1, tm);
-            const double c_t = Sweep::at(sweep.C0, sweep.C1, tm), d_t = Sweep::at(sweep.D0, sweep.D1, tm);
-            const double saddle = (a_t * c_t - b_t * d_t) / (a_t + c_t - b_t - d_t);
-            tiling = saddle >= 0 ? 1 : 2;
-        }
+        const int orientation = algorithm1(sweep);
+        tunnel = orientation != 0;
+        tiling = orientation >= 0 ? 1 : 2;
     } else {
         // mc33-lewiner on 13.5: condition (iii) at Lewiner's height, tunnel orientation never
         // tested (Custodio et al. Sec. 5.1.1, Appendix A).
-        tunnel = lewiner.F(t_alt(v, var->lewiner_edge)) > 0;
+        tunnel = lewiner.F(t_lewiner) > 0;
     }
     if (r) r->tunnel = tunnel;
     if (!tunnel) return d;
     if (r && var->test == kTest13_5) {
-        // tiling 1 faces the above corner of the isolated diagonal (corner or corner ^ 7)
-        const int above = v[var->corner] >= 0 ? var->corner : var->corner ^ 7;
-        r->tunnel_corner = tiling == 1 ? above : above ^ 7;
+        // tiling 1 faces the above corner of the isolated diagonal (kept in lewiner_corner)
+        r->tunnel_corner = tiling == 1 ? var->lewiner_corner : var->lewiner_corner ^ 7;
     }
     return {var, tiling, var->tunnel_subcase};
 }

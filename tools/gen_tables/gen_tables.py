@@ -348,16 +348,20 @@ def variants():
                 (s_plus,) = [next(iter(r)) for r in caps if (config >> next(iter(r))) & 1]
                 (s_minus,) = [next(iter(r)) for r in caps if not (config >> next(iter(r))) & 1]
                 assert s_plus ^ s_minus == 7
-                v.update(test=TEST_13_5, axis=2, corner=bottom_end(s_plus, 2))
+                # Chernyaev's sweep as in Custodio et al. Appendix A: along z, from the corner next
+                # (along x) to the isolated corner on the z = 0 face. Algorithm 1 reads only the
+                # roots of F and the slice saddles, the same for either diagonal of that face.
+                v.update(test=TEST_13_5, axis=2, corner=bottom_end(s_plus, 2) ^ 1)
                 v["tunnel_subcase"] = SUB["13.5.2"]
                 cap_loop = lambda corner: next(i for i, l in enumerate(ls) if all(corner in EDGE_CORNERS[e] for e, _ in l))
                 hexa = next(i for i, l in enumerate(ls) if len(l) == 6)
                 v["tilings"].append(tiling(ls, (cap_loop(s_plus), hexa)))   # tunnel faces s_plus
                 v["tilings"].append(tiling(ls, (cap_loop(s_minus), hexa)))  # tunnel faces s_minus
-                # Lewiner's route (Custodio et al., Appendix A): along x, from the x-neighbour of
-                # s_minus to s_minus, t_alt where the field crosses that edge
-                v["lw_axis"], v["lw_corner"] = 0, s_minus ^ 1
-                v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {s_minus, s_minus ^ 1}][0]
+                # Lewiner's route (Custodio et al., Appendix A): along x from the isolated above
+                # corner (lewiner_corner = s_plus, which decide() also reads as that corner), t_alt
+                # where the field crosses the x edge leaving it.
+                v["lw_axis"], v["lw_corner"] = 0, s_plus
+                v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {s_plus, s_plus ^ 1}][0]
             for t, (tris, interior) in enumerate(v["tilings"]):
                 check_tiling(config, ls, tris, interior, (config, joined, name, t))
             per.append(v)

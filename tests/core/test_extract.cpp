@@ -1,0 +1,244 @@
+// extract() on whole grids: analytic surfaces, ties on integer data, determinism across thread
+// counts, typed and strided views, errors, and agreement with the independent field topology.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/topology.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using cmc33::ExtractOptions;
+using cmc33::Method;
+using cmc33::Volume;
+
+const Method kMethods[] = {Method::cmc33, Method::mc33_lewiner, Method::mc};
+
+Volume sphere(int n, double r)
+{
+    const double c = (n - 1) / 2.0;
+    return cmc33::test::make_volume({n, n, n}, [&](auto i, auto j, auto k) {
+        return std::sqrt((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c)) - r;
+    });
+}
+
+Volume torus(int n, double major, double minor)
+{
+    const double c = (n - 1) / 2.0;
+    return cmc33::test::make_volume({n, n, n}, [&](auto i, auto j, auto k) {
+        const double x = i - c, y = j - c, z = k - c;
+        const double q = std::sqrt(x * x + y * y) - major;
+        return std::sqrt(q * q + z * z) - minor;
+    });
+}
+
+Volume noise(cmc33::Index3 dims, std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    return cmc33::test::make_volume(dims, [&](auto, auto, auto) { return u(rng); });
+}
+
+void expect_closed_manifold(const cmc33::Mesh& mesh, std::int64_t euler, std::int64_t components)
+{
+    const auto t = cmc33::mesh_topology(mesh);
+    EXPECT_EQ(t.nonmanifold_edges, 0);
+    EXPECT_EQ(t.nonmanifold_vertices, 0);
+    EXPECT_EQ(t.boundary_edges, 0);
+    EXPECT_EQ(t.degenerate_triangles, 0);
+    EXPECT_TRUE(t.oriented);
+    EXPECT_EQ(t.euler, euler);
+    EXPECT_EQ(t.components, components);
+    EXPECT_EQ(t.vertices, static_cast<std::int64_t>(mesh.vertex_count())); // no unused vertex
+}
+
+TEST(Extract, SphereAndTorusForEveryMethod)
+{
+    for (Method m : kMethods) {
+        SCOPED_TRACE(std::string(cmc33::method_name(m)));
+        expect_closed_manifold(cmc33::extract(sphere(24, 8.3), 0.0, {m}), 2, 1);
+        expect_closed_manifold(cmc33::extract(torus(32, 9.0, 3.7), 0.0, {m}), 0, 1);
+    }
+}
+
+TEST(Extract, NormalsPointFromAboveToBelow)
+{
+    const Volume v = sphere(20, 6.5); // above = outside the sphere, so normals point inwards
+    ExtractOptions opt;
+    opt.normals = true;
+    const cmc33::Mesh mesh = cmc33::extract(v, 0.0, opt);
+    ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
+    const double c = 9.5;
+    for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
+        const float* n = &mesh.normals[3 * i];
+        const float* p = &mesh.positions[3 * i];
+        EXPECT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-5);
+        EXPECT_LT(n[0] * (p[0] - c) + n[1] * (p[1] - c) + n[2] * (p[2] - c), 0.0);
+    }
+    // and triangles wind counter-clockwise around those normals
+    double agree = 0;
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+        const float* a = &mesh.positions[3 * mesh.triangles[3 * t]];
+        const float* b = &mesh.positions[3 * mesh.triangles[3 * t + 1]];
+        const float* d = &mesh.positions[3 * mesh.triangles[3 * t + 2]];
+        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+        const double g[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+        const float* n = &mesh.normals[3 * mesh.triangles[3 * t]];
+        agree += (g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) > 0;
+    }
+    EXPECT_EQ(agree, static_cast<double>(mesh.triangle_count()));
+}
+
+TEST(Extract, WorldCoordinatesFollowSpacingAndOrigin)
+{
+    Volume v = sphere(16, 5.2);
+    v.set_spacing({0.5, 2.0, 1.5});
+    v.set_origin({10, -3, 7});
+    const cmc33::Mesh a = cmc33::extract(sphere(16, 5.2), 0.0);
+    const cmc33::Mesh b = cmc33::extract(v, 0.0);
+    ASSERT_EQ(a.positions.size(), b.positions.size());
+    for (std::size_t i = 0; i < a.positions.size(); i += 3) {
+        EXPECT_FLOAT_EQ(b.positions[i], static_cast<float>(10 + 0.5 * a.positions[i]));
+        EXPECT_FLOAT_EQ(b.positions[i + 1], static_cast<float>(-3 + 2.0 * a.positions[i + 1]));
+        EXPECT_FLOAT_EQ(b.positions[i + 2], static_cast<float>(7 + 1.5 * a.positions[i + 2]));
+    }
+    EXPECT_EQ(a.triangles, b.triangles);
+}
+
+TEST(Extract, ByteIdenticalForEveryThreadCount)
+{
+    for (const Volume& v : {noise({23, 17, 19}, 7), torus(30, 8, 3)}) {
+        for (Method m : kMethods) {
+            ExtractOptions opt{m, true, 1};
+            const cmc33::Mesh one = cmc33::extract(v, 0.0, opt);
+            for (int threads : {2, 7}) {
+                opt.threads = threads;
+                const cmc33::Mesh many = cmc33::extract(v, 0.0, opt);
+                EXPECT_EQ(one.positions, many.positions);
+                EXPECT_EQ(one.normals, many.normals);
+                EXPECT_EQ(one.triangles, many.triangles);
+            }
+        }
+    }
+}
+
+TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
+{
+    // uint8 samples drawn from {60, 80, 100} at iso 80: a third of the samples equal iso.
+    std::mt19937_64 rng(3);
+    for (int trial = 0; trial < 20; ++trial) {
+        Volume v(cmc33::ScalarType::u8, {12, 11, 10});
+        std::uint8_t* p = v.samples<std::uint8_t>();
+        for (std::int64_t i = 0; i < v.sample_count(); ++i) p[i] = static_cast<std::uint8_t>(60 + 20 * (rng() % 3));
+        for (Method m : kMethods) {
+            const cmc33::Mesh mesh = cmc33::extract(v, 80.0, {m});
+            const auto t = cmc33::mesh_topology(mesh);
+            EXPECT_EQ(t.nonmanifold_edges, 0);
+            EXPECT_EQ(t.nonmanifold_vertices, 0);
+            EXPECT_EQ(t.degenerate_triangles, 0);
+            EXPECT_TRUE(t.oriented);
+            // boundary edges only on the volume's outer faces
+            const auto on_box = [&](std::uint32_t id) {
+                const float* q = &mesh.positions[3 * id];
+                return q[0] == 0 || q[0] == 11 || q[1] == 0 || q[1] == 10 || q[2] == 0 || q[2] == 9;
+            };
+            std::vector<std::pair<std::uint32_t, std::uint32_t>> edges;
+            for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+                for (int s = 0; s < 3; ++s) {
+                    const auto a = mesh.triangles[3 * f + s], b = mesh.triangles[3 * f + (s + 1) % 3];
+                    edges.emplace_back(std::min(a, b), std::max(a, b));
+                }
+            std::sort(edges.begin(), edges.end());
+            for (std::size_t e = 0; e < edges.size(); ++e) {
+                const bool single = (e == 0 || edges[e - 1] != edges[e]) && (e + 1 == edges.size() || edges[e + 1] != edges[e]);
+                if (single) EXPECT_TRUE(on_box(edges[e].first) && on_box(edges[e].second));
+            }
+            // the same as iso a hair lower on float data (the sign rule)
+            Volume f(cmc33::ScalarType::f32, v.dims());
+            for (std::int64_t i = 0; i < v.sample_count(); ++i) f.samples<float>()[i] = p[i];
+            const auto tf = cmc33::mesh_topology(cmc33::extract(f, 80.0 - 1e-3, {m}));
+            EXPECT_EQ(tf.euler, t.euler);
+            EXPECT_EQ(tf.components, t.components);
+            EXPECT_EQ(tf.faces, t.faces);
+        }
+    }
+}
+
+TEST(Extract, TypedAndStridedViewsGiveTheSameMesh)
+{
+    std::mt19937_64 rng(11);
+    Volume u8(cmc33::ScalarType::u8, {9, 8, 7}), f64(cmc33::ScalarType::f64, {9, 8, 7});
+    for (std::int64_t i = 0; i < u8.sample_count(); ++i) {
+        const auto x = static_cast<std::uint8_t>(rng() % 200);
+        u8.samples<std::uint8_t>()[i] = x;
+        f64.samples<double>()[i] = x;
+    }
+    const cmc33::Mesh a = cmc33::extract(u8, 99.5), b = cmc33::extract(f64, 99.5);
+    EXPECT_EQ(a.positions, b.positions);
+    EXPECT_EQ(a.triangles, b.triangles);
+    // a sub-block view of a larger array, no copy
+    std::vector<double> big(20 * 20 * 20, 500.0);
+    for (int k = 0; k < 7; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 9; ++i) big[static_cast<std::size_t>((i + 3) + 20 * ((j + 2) + 20 * (k + 1)))] = f64.samples<double>()[i + 9 * (j + 8 * k)];
+    cmc33::GridView<double> view{&big[3 + 20 * (2 + 20 * 1)], {9, 8, 7}, {1, 20, 400}, {1, 1, 1}, {0, 0, 0}};
+    const cmc33::Mesh c = cmc33::extract(view, 99.5);
+    EXPECT_EQ(a.positions, c.positions);
+    EXPECT_EQ(a.triangles, c.triangles);
+}
+
+TEST(Extract, RejectsNonFiniteAndTooSmallGrids)
+{
+    Volume v(cmc33::ScalarType::f32, {4, 4, 4});
+    v.samples<float>()[5] = std::numeric_limits<float>::quiet_NaN();
+    v.samples<float>()[9] = std::numeric_limits<float>::infinity();
+    try {
+        cmc33::extract(v, 0.0);
+        FAIL() << "no error";
+    } catch (const cmc33::Error& e) {
+        EXPECT_EQ(e.status(), cmc33::Status::non_finite);
+        EXPECT_NE(std::string(e.what()).find("2 samples"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("(1, 1, 0)"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(cmc33::extract(sphere(5, 1), std::nan("")), cmc33::Error);
+    EXPECT_THROW(cmc33::extract(Volume(cmc33::ScalarType::u8, {1, 5, 5}), 1.0), cmc33::Error);
+}
+
+// The mesh of cmc33 has the topology of the trilinear interpolant's level set; the earlier
+// methods do not always (Custodio et al. 2013). Compared with the independent field topology.
+TEST(Extract, RandomGridsMatchTheFieldTopology)
+{
+    int mismatches[3] = {0, 0, 0};
+    int undetermined = 0;
+    for (std::uint64_t seed = 0; seed < 400; ++seed) {
+        const Volume v = noise({5, 5, 5}, 1000 + seed);
+        const auto field = cmc33::field_topology(v, 0.0);
+        if (!field.determined) {
+            ++undetermined;
+            continue;
+        }
+        for (int m = 0; m < 3; ++m) {
+            const auto t = cmc33::mesh_topology(cmc33::extract(v, 0.0, {kMethods[m]}));
+            if (kMethods[m] == Method::cmc33) {
+                EXPECT_EQ(t.nonmanifold_edges, 0);
+                EXPECT_EQ(t.nonmanifold_vertices, 0);
+            }
+            const bool match = t.euler == field.euler && t.components == field.b0 && t.b1 == field.b1 &&
+                               t.closed_components == field.b2 && t.boundary_loops == field.boundary_loops;
+            mismatches[m] += !match;
+            if (kMethods[m] == Method::cmc33) EXPECT_TRUE(match) << "seed " << 1000 + seed;
+        }
+    }
+    EXPECT_LE(undetermined, 4);
+    EXPECT_EQ(mismatches[0], 0);
+    EXPECT_GT(mismatches[2], 0) << "classic Marching Cubes should disagree on random grids";
+}
+
+} // namespace
