@@ -101,43 +101,77 @@ inline bool saddle_inside(const SweepEps& s, Eps t)
 /// Chernyaev's test (Custodio et al. 2013, Sec. 3.1): joined iff a < 0, t_max = -b/2a in (0, 1)
 /// and the slice at t_max joins A and C (for the tunnel cases the slice's own sign pattern is read,
 /// so condition (iii) F(t_max) > 0 becomes "the slice joins them").
+/// Nothing is divided: with a < 0, sign(X(t_max)) = sign((X1 - X0) b - 2a X0) and
+/// F(t_max) = (4ac - b^2) / 4a has the sign of b^2 - 4ac. On data with exact ties (integers,
+/// dyadic fractions) these are exact, so a zero is a true zero and the eps terms decide it.
 inline bool chernyaev_joined(const SweepEps& s)
 {
-    const Eps a = s.a(), b = s.b(); // a carries no eps: it is made of differences
+    const Eps a = s.a(), b = s.b(), c = s.c(); // a carries no eps: it is made of differences
     if (!(a.x < 0)) return false;
-    const Eps t_max = (-0.5 / a.x) * b;
-    return t_max.sign() > 0 && (Eps{1, 0} - t_max).sign() > 0 && slice_joins(s, t_max);
+    if (b.sign() <= 0 || (2.0 * a + b).sign() >= 0) return false; // t_max outside (0, 1)
+    const Eps two_a = 2.0 * a;
+    const auto above_at_max = [&](Eps x0, Eps x1) { return ((x1 - x0) * b - two_a * x0).above(); };
+    const bool joined_sign = s.A0.above();
+    if (above_at_max(s.A0, s.A1) != joined_sign || above_at_max(s.C0, s.C1) != joined_sign) return false;
+    if (above_at_max(s.B0, s.B1) == joined_sign || above_at_max(s.D0, s.D1) == joined_sign) return true;
+    // F(t_max): b^2 - 4ac to first order in eps, and its eps^2 term b.y^2 when both vanish
+    const Eps g = b * b - 4.0 * (a * c);
+    const int f = g.sign() != 0 ? g.sign() : (b.y != 0 ? 1 : 0);
+    return joined_sign ? f >= 0 : f > 0;
+}
+
+/// Sign of P + Q sqrt(D), D >= 0, without rounding a square root: compare P^2 with Q^2 D. When
+/// D is an infinitesimal eps * D.y, sqrt(D) ~ sqrt(eps) outweighs any eps term.
+inline int sign_p_plus_q_sqrt(Eps P, Eps Q, Eps D)
+{
+    if (D.x == 0) {
+        if (P.x != 0) return P.x > 0 ? 1 : -1;
+        if (Q.x != 0 && D.y > 0) return Q.x > 0 ? 1 : -1;
+        return P.sign() != 0 ? P.sign() : Q.sign();
+    }
+    const int sp = P.sign(), sq = Q.sign();
+    if (sq == 0) return sp;
+    if (sp == 0 || sp == sq) return sq;
+    const int cmp = (P * P - (Q * Q) * D).sign();
+    return cmp > 0 ? sp : cmp < 0 ? sq : 0;
+}
+
+/// Sign of l0 + l1 t at the root t = (-b + sigma sqrt(disc)) / 2a of F (a != 0).
+inline int sign_at_root(Eps l0, Eps l1, Eps a, Eps b, Eps disc, int sigma)
+{
+    const Eps P = 2.0 * (a * l0) - l1 * b;
+    const Eps Q = static_cast<double>(sigma) * l1;
+    return sign_p_plus_q_sqrt(P, Q, disc) * (a.x > 0 ? 1 : -1);
 }
 
 /// Algorithm 1 (Custodio et al. 2013, Sec. 6.1): 13.5.2 iff both roots t1, t2 of F lie in (0, 1)
-/// and both slice saddles x_c(t1), x_c(t2) lie inside the face. Returns 0 for 13.5.1, else the
-/// sign (+1, -1) of the slice saddle at (t1 + t2) / 2: the tunnel faces the isolated corner of
-/// that sign (Sec. 6.1.1).
+/// and both slice saddles x_c(t1), x_c(t2) (Eq. 9) lie inside the face. Returns 0 for 13.5.1, else
+/// the sign (+1, -1) of the slice saddle at (t1 + t2) / 2: the tunnel faces the isolated corner of
+/// that sign (Sec. 6.1.1). Every quantity is linear in t and is evaluated at the roots exactly
+/// (sign_at_root), so ties in the data cannot be decided by rounding.
 inline int algorithm1(const SweepEps& s)
 {
     const Eps a = s.a(), b = s.b(), c = s.c();
     if (a.x == 0) return 0; // F is at most linear: one root
     const Eps disc = b * b - 4.0 * (a * c);
-    Eps t1, t2;
-    if (disc.x > 0) {
-        const double r = std::sqrt(disc.x);
-        const Eps root{r, disc.y / (2 * r)};
-        t1 = (0.5 / a.x) * (Eps{0, 0} - b - root);
-        t2 = (0.5 / a.x) * (Eps{0, 0} - b + root);
-    } else if (disc.x == 0 && disc.y > 0) {
-        // a double root split by sqrt(eps): both roots sit at t0 up to sqrt(eps), which dominates
-        // eps, so "inside" is decided by t0 alone and must be strict.
-        const Eps t0 = (-0.5 / a.x) * b;
-        if (!(t0.x > 0 && t0.x < 1)) return 0;
-        t1 = t2 = Eps{t0.x, 0};
-    } else {
-        return 0;
+    if (disc.sign() <= 0) return 0; // no real roots, or a double root even below iso
+    const Eps one{1, 0}, zero{0, 0};
+    const Eps dA = s.A1 - s.A0, dB = s.B1 - s.B0, dC = s.C1 - s.C0, dD = s.D1 - s.D0;
+    for (int sigma : {-1, 1}) {
+        const auto sg = [&](Eps l0, Eps l1) { return sign_at_root(l0, l1, a, b, disc, sigma); };
+        if (sg(zero, one) <= 0 || sg(one, zero - one) <= 0) return 0; // root in (0, 1)
+        // saddle (u, v) = (A - D, A - B) / den inside: A - D, C - B, A - B, C - D all of den's sign
+        const int sd = sg(s.A0 + s.C0 - s.B0 - s.D0, dA + dC - dB - dD);
+        if (sd == 0 || sg(s.A0 - s.D0, dA - dD) != sd || sg(s.C0 - s.B0, dC - dB) != sd ||
+            sg(s.A0 - s.B0, dA - dB) != sd || sg(s.C0 - s.D0, dC - dD) != sd) {
+            return 0;
+        }
     }
-    const auto inside = [&](Eps t) { return t.sign() > 0 && (Eps{1, 0} - t).sign() > 0 && saddle_inside(s, t); };
-    if (!inside(t1) || !inside(t2)) return 0;
-    const Eps tm = 0.5 * (t1 + t2);
-    const int saddle = s.F(tm).sign() * s.den(tm).sign();
-    return saddle >= 0 ? 1 : -1;
+    // At the midpoint t = -b / 2a: F = -disc / 4a, and den's sign from 2a den0 - den1 b.
+    const int f_sign = -(a.x > 0 ? 1 : -1);
+    const Eps den0 = s.A0 + s.C0 - s.B0 - s.D0, den1 = dA + dC - dB - dD;
+    const int den_sign = (2.0 * (a * den0) - den1 * b).sign() * (a.x > 0 ? 1 : -1);
+    return f_sign * den_sign >= 0 ? 1 : -1;
 }
 
 /// Lewiner et al.'s height: where the field crosses the reference edge (Custodio et al., Eq. 8).
