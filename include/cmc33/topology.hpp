@@ -30,6 +30,9 @@ struct MeshTopology {
     bool oriented = false; ///< every edge with two triangles is used once in each direction
 };
 
+/// @throws Error{invalid_argument} if an index is not below the vertex count or the triangle array
+/// is not a multiple of 3.
+/// Cost: O(F) time and about 24 bytes per triangle of working memory.
 MeshTopology mesh_topology(const Mesh& mesh);
 
 /// Invariants of S = {x : f(x) = iso} inside the grid's box, f the piecewise-trilinear

@@ -1,0 +1,127 @@
+#pragma once
+// Internal: the mesh formats behind io::read_mesh / io::write_mesh (include/cmc33/io.hpp), and the
+// small text and byte helpers they share (defined in mesh_io.cpp).
+//
+// Readers parse a whole file image held in memory (`bytes`, exactly the file's size) and name the
+// file as `name` in their messages. They trust nothing in it: every count is checked against the
+// bytes that remain before anything is allocated from it, and every read is bounds-checked.
+// Writers stream a mesh that write_mesh() has already validated (sizes, indices < vertex count).
+
+#include <charconv>
+#include <cstdint>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/mesh.hpp"
+
+namespace cmc33::io::detail {
+
+Mesh read_ply(std::string_view bytes, const std::string& name);
+Mesh read_obj(std::string_view bytes, const std::string& name);
+Mesh read_stl(std::string_view bytes, const std::string& name);
+Mesh read_off(std::string_view bytes, const std::string& name);
+
+void write_ply(const Mesh& mesh, std::ostream& out, bool ascii);
+void write_obj(const Mesh& mesh, std::ostream& out);
+void write_stl(const Mesh& mesh, std::ostream& out);
+void write_off(const Mesh& mesh, std::ostream& out);
+
+/// Reads a mesh image by the extension of `name` (".ply", ".obj", ".stl", ".off").
+/// @throws Error{unsupported_format} for another extension, Error for bad content.
+Mesh read_mesh_bytes(std::string_view bytes, const std::string& name);
+
+// ---- messages -------------------------------------------------------------------------------
+
+/// Concatenates anything `ostream <<` accepts.
+template <class... Parts> std::string concat(const Parts&... parts)
+{
+    std::ostringstream s;
+    (s << ... << parts);
+    return s.str();
+}
+
+/// `text` in double quotes, non-printable bytes as \xNN, cut after `max_chars` characters.
+std::string quote_text(std::string_view text, std::size_t max_chars = 32);
+
+// ---- numbers --------------------------------------------------------------------------------
+// The whole token must be the number; a leading '+' is accepted. Floats accept "nan" and "inf".
+// A decimal beyond float range becomes +-inf or a (sub)normal/zero, like strtof.
+
+bool parse_float(std::string_view token, float& value);
+bool parse_double(std::string_view token, double& value);
+bool parse_int(std::string_view token, std::int64_t& value);
+
+// ---- text -----------------------------------------------------------------------------------
+
+/// Whitespace-separated tokens over a text, with line numbers. '\n' ends a line ("\r\n" too);
+/// when `comment` is not 0, a token starting with it hides the rest of its line.
+class TextCursor {
+public:
+    explicit TextCursor(std::string_view text, char comment = 0) : text_(text), comment_(comment) {}
+
+    /// The next token, on this line or a later one. False at the end of the text.
+    bool next_token(std::string_view& token);
+    /// The next token on the current line. False at the end of the line (which is not consumed).
+    bool next_token_in_line(std::string_view& token);
+    /// Moves past the end of the current line.
+    void skip_line();
+    /// The rest of the current line, without the line end (not consumed).
+    std::string_view rest_of_line() const;
+    /// 1-based number of the line the cursor is on.
+    std::size_t line() const noexcept { return line_; }
+    /// Bytes not yet consumed.
+    std::size_t remaining() const noexcept { return text_.size() - pos_; }
+
+private:
+    void skip_blanks();
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t line_ = 1;
+    char comment_;
+};
+
+// ---- output ---------------------------------------------------------------------------------
+
+/// Accumulates output and hands it to the stream in large blocks.
+class OutputBuffer {
+public:
+    explicit OutputBuffer(std::ostream& out) : out_(out) { buffer_.reserve(kBlock + 256); }
+    ~OutputBuffer() = default;
+    OutputBuffer(const OutputBuffer&) = delete;
+    OutputBuffer& operator=(const OutputBuffer&) = delete;
+
+    void text(std::string_view s)
+    {
+        buffer_.append(s);
+        maybe_flush();
+    }
+    void character(char c)
+    {
+        buffer_.push_back(c);
+        maybe_flush();
+    }
+    /// Shortest decimal that reads back as exactly `value` (std::to_chars).
+    void real(float value);
+    void integer(std::uint64_t value);
+    void u8(std::uint8_t value) { character(static_cast<char>(value)); }
+    void u16_le(std::uint16_t value);
+    void u32_le(std::uint32_t value);
+    void f32_le(float value);
+    /// Writes what is left; call once at the end.
+    void flush();
+
+private:
+    static constexpr std::size_t kBlock = 1 << 20;
+    void maybe_flush()
+    {
+        if (buffer_.size() >= kBlock) flush();
+    }
+    std::ostream& out_;
+    std::string buffer_;
+};
+
+} // namespace cmc33::io::detail

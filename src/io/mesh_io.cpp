@@ -1,0 +1,385 @@
+// io::read_mesh / io::write_mesh: choose the format by extension, map the input file, validate the
+// mesh before writing. Also the text/number/output helpers of mesh_formats.hpp.
+
+#include <bit>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <system_error>
+
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
+#include "io/atomic_file.hpp"
+#include "io/mesh_formats.hpp"
+
+namespace cmc33::io {
+namespace detail {
+
+// ---- messages -------------------------------------------------------------------------------
+
+std::string quote_text(std::string_view text, std::size_t max_chars)
+{
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string s = "\"";
+    for (std::size_t i = 0; i < text.size() && i < max_chars; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+            s += static_cast<char>(c);
+        } else {
+            s += "\\x";
+            s += kHex[c >> 4];
+            s += kHex[c & 15];
+        }
+    }
+    if (text.size() > max_chars) s += "...";
+    s += '"';
+    return s;
+}
+
+// ---- numbers --------------------------------------------------------------------------------
+
+namespace {
+
+std::string_view without_plus(std::string_view token)
+{
+    // from_chars rejects a leading '+'; "+-1" must stay invalid.
+    if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
+        token.remove_prefix(1);
+    }
+    return token;
+}
+
+} // namespace
+
+bool parse_double(std::string_view token, double& value)
+{
+    token = without_plus(token);
+    const char* end = token.data() + token.size();
+    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+    if (ptr != end || token.empty()) return false;
+    if (ec == std::errc::result_out_of_range) {
+        // from_chars leaves value unchanged here; strtod gives the IEEE result (inf or
+        // 0/subnormal).
+        const std::string copy(token);
+        value = std::strtod(copy.c_str(), nullptr);
+        return true;
+    }
+    return ec == std::errc();
+}
+
+bool parse_float(std::string_view token, float& value)
+{
+    token = without_plus(token);
+    const char* end = token.data() + token.size();
+    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+    if (ptr != end || token.empty()) return false;
+    if (ec == std::errc::result_out_of_range) {
+        const std::string copy(token);
+        value = std::strtof(copy.c_str(), nullptr);
+        return true;
+    }
+    return ec == std::errc();
+}
+
+bool parse_int(std::string_view token, std::int64_t& value)
+{
+    token = without_plus(token);
+    const char* end = token.data() + token.size();
+    const auto [ptr, ec] = std::from_chars(token.data(), end, value);
+    return ec == std::errc() && ptr == end && !token.empty();
+}
+
+// ---- text -----------------------------------------------------------------------------------
+
+namespace {
+
+bool is_blank(char c)
+{
+    return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+} // namespace
+
+void TextCursor::skip_blanks()
+{
+    while (pos_ < text_.size() && is_blank(text_[pos_])) ++pos_;
+    if (comment_ != 0 && pos_ < text_.size() && text_[pos_] == comment_) {
+        while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    }
+}
+
+bool TextCursor::next_token_in_line(std::string_view& token)
+{
+    skip_blanks();
+    if (pos_ >= text_.size() || text_[pos_] == '\n') return false;
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !is_blank(text_[pos_]) && text_[pos_] != '\n') ++pos_;
+    token = text_.substr(start, pos_ - start);
+    return true;
+}
+
+bool TextCursor::next_token(std::string_view& token)
+{
+    for (;;) {
+        if (next_token_in_line(token)) return true;
+        if (pos_ >= text_.size()) return false;
+        ++pos_; // the '\n'
+        ++line_;
+    }
+}
+
+void TextCursor::skip_line()
+{
+    while (pos_ < text_.size() && text_[pos_] != '\n') ++pos_;
+    if (pos_ < text_.size()) {
+        ++pos_;
+        ++line_;
+    }
+}
+
+std::string_view TextCursor::rest_of_line() const
+{
+    std::size_t end = pos_;
+    while (end < text_.size() && text_[end] != '\n') ++end;
+    std::string_view rest = text_.substr(pos_, end - pos_);
+    while (!rest.empty() && is_blank(rest.back())) rest.remove_suffix(1);
+    while (!rest.empty() && is_blank(rest.front())) rest.remove_prefix(1);
+    return rest;
+}
+
+// ---- output ---------------------------------------------------------------------------------
+
+void OutputBuffer::real(float value)
+{
+    char digits[32];
+    const auto result = std::to_chars(digits, digits + sizeof digits, value);
+    buffer_.append(digits, result.ptr);
+    maybe_flush();
+}
+
+void OutputBuffer::integer(std::uint64_t value)
+{
+    char digits[24];
+    const auto result = std::to_chars(digits, digits + sizeof digits, value);
+    buffer_.append(digits, result.ptr);
+    maybe_flush();
+}
+
+void OutputBuffer::u16_le(std::uint16_t value)
+{
+    buffer_.push_back(static_cast<char>(value & 0xff));
+    buffer_.push_back(static_cast<char>(value >> 8));
+    maybe_flush();
+}
+
+void OutputBuffer::u32_le(std::uint32_t value)
+{
+    for (int shift = 0; shift < 32; shift += 8) {
+        buffer_.push_back(static_cast<char>((value >> shift) & 0xff));
+    }
+    maybe_flush();
+}
+
+void OutputBuffer::f32_le(float value)
+{
+    u32_le(std::bit_cast<std::uint32_t>(value));
+}
+
+void OutputBuffer::flush()
+{
+    out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
+    buffer_.clear();
+}
+
+// ---- dispatch -------------------------------------------------------------------------------
+
+namespace {
+
+constexpr const char* kAcceptedExtensions = ".ply, .obj, .stl or .off";
+
+[[noreturn]] void unsupported_extension(const std::string& name, const std::string& ext)
+{
+    throw Error(Status::unsupported_format, concat(name, ": unsupported mesh extension ",
+                                                   ext.empty() ? "(none)" : quote_text(ext),
+                                                   "; expected ", kAcceptedExtensions));
+}
+
+bool is_mesh_extension(const std::string& ext)
+{
+    return ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".off";
+}
+
+} // namespace
+
+Mesh read_mesh_bytes(std::string_view bytes, const std::string& name)
+{
+    const std::string ext = lower_extension(name);
+    if (!is_mesh_extension(ext)) unsupported_extension(name, ext);
+    if (bytes.empty()) {
+        throw Error(Status::truncated_file,
+                    concat(name, ": the file is empty; expected a ", ext.substr(1), " mesh"));
+    }
+    if (ext == ".ply") return read_ply(bytes, name);
+    if (ext == ".obj") return read_obj(bytes, name);
+    if (ext == ".stl") return read_stl(bytes, name);
+    return read_off(bytes, name);
+}
+
+} // namespace detail
+
+namespace {
+
+// Closes a descriptor on every path out of FileImage's constructor.
+struct Descriptor {
+    int fd = -1;
+    ~Descriptor()
+    {
+        if (fd >= 0) ::close(fd);
+    }
+};
+
+// A read-only view of a whole file: memory-mapped (no copy; pages are read on demand), or read
+// into memory where mapping is refused. A mapped file cut short by another process while being
+// read would raise SIGBUS; our own writers never do that, they replace files by renaming.
+class FileImage {
+public:
+    explicit FileImage(const std::filesystem::path& path)
+    {
+        const std::string name = path.string();
+        Descriptor file{::open(name.c_str(), O_RDONLY | O_CLOEXEC)};
+        if (file.fd < 0) {
+            const int err = errno;
+            throw Error(Status::io_error,
+                        detail::concat(name, ": cannot open: ", std::strerror(err)));
+        }
+        struct stat info {};
+        if (::fstat(file.fd, &info) != 0) {
+            const int err = errno;
+            throw Error(Status::io_error,
+                        detail::concat(name, ": cannot stat: ", std::strerror(err)));
+        }
+        if (S_ISDIR(info.st_mode)) {
+            throw Error(Status::io_error, name + ": is a directory; expected a mesh file");
+        }
+        if (!S_ISREG(info.st_mode)) {
+            throw Error(Status::io_error, name + ": is not a regular file; expected a mesh file");
+        }
+        size_ = static_cast<std::size_t>(info.st_size);
+        if (size_ == 0) return;
+        void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, file.fd, 0);
+        if (map != MAP_FAILED) {
+            map_ = map;
+            data_ = static_cast<const char*>(map);
+            ::madvise(map, size_, MADV_SEQUENTIAL);
+            return;
+        }
+        copy_.resize(size_);
+        std::size_t done = 0;
+        while (done < size_) {
+            const ::ssize_t got = ::read(file.fd, copy_.data() + done, size_ - done);
+            if (got < 0 && errno == EINTR) continue;
+            if (got < 0) {
+                const int err = errno;
+                throw Error(Status::io_error, detail::concat(name, ": read failed after ", done,
+                                                             " bytes: ", std::strerror(err)));
+            }
+            if (got == 0) {
+                throw Error(Status::io_error, detail::concat(name, ": the file shrank to ", done,
+                                                             " bytes while being read"));
+            }
+            done += static_cast<std::size_t>(got);
+        }
+        data_ = copy_.data();
+    }
+    ~FileImage()
+    {
+        if (map_ != nullptr) ::munmap(map_, size_);
+    }
+    FileImage(const FileImage&) = delete;
+    FileImage& operator=(const FileImage&) = delete;
+
+    std::string_view bytes() const noexcept { return {data_, size_}; }
+
+private:
+    void* map_ = nullptr;
+    const char* data_ = nullptr;
+    std::size_t size_ = 0;
+    std::string copy_;
+};
+
+void validate_for_writing(const Mesh& mesh, const std::string& name)
+{
+    auto fail = [&](const std::string& what) {
+        throw Error(Status::invalid_argument, name + ": cannot write the mesh: " + what);
+    };
+    if (mesh.positions.size() % 3 != 0) {
+        fail(detail::concat("positions hold ", mesh.positions.size(),
+                            " floats; expected a multiple of 3"));
+    }
+    if (!mesh.normals.empty() && mesh.normals.size() != mesh.positions.size()) {
+        fail(detail::concat("normals hold ", mesh.normals.size(), " floats; expected 0 or ",
+                            mesh.positions.size(), " (3 per vertex)"));
+    }
+    if (mesh.triangles.size() % 3 != 0) {
+        fail(detail::concat("triangles hold ", mesh.triangles.size(),
+                            " indices; expected a multiple of 3"));
+    }
+    if (mesh.vertex_count() > std::numeric_limits<std::uint32_t>::max()) {
+        throw Error(Status::too_large, detail::concat(name, ": cannot write ", mesh.vertex_count(),
+                                                      " vertices; at most 4294967295"));
+    }
+    const std::size_t n = mesh.vertex_count();
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+        if (mesh.triangles[i] >= n) {
+            fail(detail::concat("triangle ", i / 3, " uses vertex ", mesh.triangles[i],
+                                " but the mesh has ", n, " vertices"));
+        }
+    }
+}
+
+} // namespace
+
+void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
+                const MeshWriteOptions& options)
+{
+    const std::string name = path.string();
+    const std::string ext = detail::lower_extension(path);
+    if (!detail::is_mesh_extension(ext)) detail::unsupported_extension(name, ext);
+    validate_for_writing(mesh, name);
+    if (ext == ".stl" && mesh.triangle_count() > std::numeric_limits<std::uint32_t>::max()) {
+        throw Error(Status::too_large, detail::concat(name,
+                                                      ": binary STL holds at most 4294967295 "
+                                                      "triangles, not ",
+                                                      mesh.triangle_count()));
+    }
+    detail::write_atomically(path, [&](std::ostream& out) {
+        if (ext == ".ply") {
+            detail::write_ply(mesh, out, options.ascii);
+        } else if (ext == ".obj") {
+            detail::write_obj(mesh, out);
+        } else if (ext == ".stl") {
+            detail::write_stl(mesh, out);
+        } else {
+            detail::write_off(mesh, out);
+        }
+    });
+}
+
+Mesh read_mesh(const std::filesystem::path& path)
+{
+    const std::string name = path.string();
+    const std::string ext = detail::lower_extension(path);
+    if (!detail::is_mesh_extension(ext)) detail::unsupported_extension(name, ext);
+    const FileImage file(path);
+    return detail::read_mesh_bytes(file.bytes(), name);
+}
+
+} // namespace cmc33::io
