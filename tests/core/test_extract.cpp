@@ -77,20 +77,24 @@ TEST(Extract, NormalsPointFromAboveToBelow)
     ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
     const double c = 9.5;
     for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
-        const float* n = &mesh.normals[3 * i];
-        const float* p = &mesh.positions[3 * i];
+        const double n[3] = {mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]};
+        const double p[3] = {mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]};
         EXPECT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-5);
         EXPECT_LT(n[0] * (p[0] - c) + n[1] * (p[1] - c) + n[2] * (p[2] - c), 0.0);
     }
     // and triangles wind counter-clockwise around those normals
     double agree = 0;
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-        const float* a = &mesh.positions[3 * mesh.triangles[3 * t]];
-        const float* b = &mesh.positions[3 * mesh.triangles[3 * t + 1]];
-        const float* d = &mesh.positions[3 * mesh.triangles[3 * t + 2]];
-        const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+        const auto at = [&](const std::vector<float>& xs, std::size_t corner, int k) {
+            return static_cast<double>(xs[3 * mesh.triangles[3 * t + corner] + static_cast<std::size_t>(k)]);
+        };
+        double u[3], w[3], n[3];
+        for (int k = 0; k < 3; ++k) {
+            u[k] = at(mesh.positions, 1, k) - at(mesh.positions, 0, k);
+            w[k] = at(mesh.positions, 2, k) - at(mesh.positions, 0, k);
+            n[k] = at(mesh.normals, 0, k);
+        }
         const double g[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
-        const float* n = &mesh.normals[3 * mesh.triangles[3 * t]];
         agree += (g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) > 0;
     }
     EXPECT_EQ(agree, static_cast<double>(mesh.triangle_count()));
@@ -105,9 +109,9 @@ TEST(Extract, WorldCoordinatesFollowSpacingAndOrigin)
     const cmc33::Mesh b = cmc33::extract(v, 0.0);
     ASSERT_EQ(a.positions.size(), b.positions.size());
     for (std::size_t i = 0; i < a.positions.size(); i += 3) {
-        EXPECT_FLOAT_EQ(b.positions[i], static_cast<float>(10 + 0.5 * a.positions[i]));
-        EXPECT_FLOAT_EQ(b.positions[i + 1], static_cast<float>(-3 + 2.0 * a.positions[i + 1]));
-        EXPECT_FLOAT_EQ(b.positions[i + 2], static_cast<float>(7 + 1.5 * a.positions[i + 2]));
+        EXPECT_FLOAT_EQ(b.positions[i], static_cast<float>(10 + 0.5 * static_cast<double>(a.positions[i])));
+        EXPECT_FLOAT_EQ(b.positions[i + 1], static_cast<float>(-3 + 2.0 * static_cast<double>(a.positions[i + 1])));
+        EXPECT_FLOAT_EQ(b.positions[i + 2], static_cast<float>(7 + 1.5 * static_cast<double>(a.positions[i + 2])));
     }
     EXPECT_EQ(a.triangles, b.triangles);
 }
@@ -158,7 +162,9 @@ TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
             std::sort(edges.begin(), edges.end());
             for (std::size_t e = 0; e < edges.size(); ++e) {
                 const bool single = (e == 0 || edges[e - 1] != edges[e]) && (e + 1 == edges.size() || edges[e + 1] != edges[e]);
-                if (single) EXPECT_TRUE(on_box(edges[e].first) && on_box(edges[e].second));
+                if (single) {
+                    EXPECT_TRUE(on_box(edges[e].first) && on_box(edges[e].second));
+                }
             }
             // the same as iso a hair lower on float data (the sign rule)
             Volume f(cmc33::ScalarType::f32, v.dims());
@@ -233,7 +239,9 @@ TEST(Extract, RandomGridsMatchTheFieldTopology)
             const bool match = t.euler == field.euler && t.components == field.b0 && t.b1 == field.b1 &&
                                t.closed_components == field.b2 && t.boundary_loops == field.boundary_loops;
             mismatches[m] += !match;
-            if (kMethods[m] == Method::cmc33) EXPECT_TRUE(match) << "seed " << 1000 + seed;
+            if (kMethods[m] == Method::cmc33) {
+                EXPECT_TRUE(match) << "seed " << 1000 + seed;
+            }
         }
     }
     EXPECT_LE(undetermined, 4);

@@ -80,7 +80,9 @@ TEST_P(Subcase, ClassificationAndCellTopology)
     EXPECT_EQ(t.nonmanifold_edges, 0);
     EXPECT_EQ(t.nonmanifold_vertices, 0);
     EXPECT_EQ(t.degenerate_triangles, 0);
-    if (r.mesh.triangle_count() > 0) EXPECT_TRUE(t.oriented);
+    if (r.mesh.triangle_count() > 0) {
+        EXPECT_TRUE(t.oriented);
+    }
     // The independent verifier agrees with the cell mesh (one cell: the box is the cell).
     const cmc33::FieldTopology f = field_of(cell.values, 0.0);
     ASSERT_TRUE(f.determined) << f.why;
@@ -89,8 +91,8 @@ TEST_P(Subcase, ClassificationAndCellTopology)
     EXPECT_EQ(f.boundary_loops, t.boundary_loops);
 }
 
-INSTANTIATE_TEST_SUITE_P(AllSubcases, Subcase, ::testing::ValuesIn(kCells), [](const auto& info) {
-    std::string name = std::string("s") + info.param.subcase;
+INSTANTIATE_TEST_SUITE_P(AllSubcases, Subcase, ::testing::ValuesIn(kCells), [](const auto& p) {
+    std::string name = std::string("s") + p.param.subcase;
     for (char& c : name) c = c == '.' ? '_' : c;
     return name;
 });

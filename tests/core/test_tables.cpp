@@ -113,7 +113,9 @@ TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
                     for (int s = 0; s < 3; ++s) {
                         const int a = tri[s], b = tri[(s + 1) % 3];
                         ASSERT_NE(a, b);
-                        if (a < 12) ASSERT_TRUE(crossed(config, a)) << "vertex on uncrossed edge " << a;
+                        if (a < 12) {
+                            ASSERT_TRUE(crossed(config, a)) << "vertex on uncrossed edge " << a;
+                        }
                         ASSERT_LT(a, 12 + tl.interior_count);
                         verts.insert(a);
                         ++directed[{a, b}];
