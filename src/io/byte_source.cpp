@@ -1,0 +1,335 @@
+#include "io/byte_source.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <cstring>
+#include <limits>
+#include <system_error>
+#include <utility>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <zlib.h>
+
+#include "cmc33/error.hpp"
+
+namespace cmc33::io::detail {
+
+namespace {
+
+std::string errno_text(int error)
+{
+    return std::error_code(error, std::generic_category()).message();
+}
+
+} // namespace
+
+// ---- InputFile ------------------------------------------------------------------------------
+
+InputFile::InputFile(const std::filesystem::path& path, std::string label)
+    : label_(std::move(label))
+{
+    // O_NONBLOCK: opening a FIFO must not wait for a writer; it is rejected below as not regular.
+    do {
+        fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+    } while (fd_ < 0 && errno == EINTR);
+    if (fd_ < 0) {
+        throw Error(Status::io_error, label_ + ": cannot open the file: " + errno_text(errno));
+    }
+    struct stat info {};
+    if (::fstat(fd_, &info) != 0) {
+        const int error = errno;
+        ::close(fd_);
+        throw Error(Status::io_error,
+                    label_ + ": cannot read the file's size: " + errno_text(error));
+    }
+    if (S_ISDIR(info.st_mode)) {
+        ::close(fd_);
+        throw Error(Status::io_error, label_ + ": is a directory, expected a volume file");
+    }
+    if (!S_ISREG(info.st_mode)) {
+        ::close(fd_);
+        throw Error(Status::io_error, label_ + ": is not a regular file, expected a volume file");
+    }
+    size_ = static_cast<std::uint64_t>(info.st_size);
+}
+
+InputFile::~InputFile()
+{
+    if (fd_ >= 0) ::close(fd_);
+}
+
+void InputFile::read(std::uint64_t offset, void* out, std::size_t count) const
+{
+    if (offset > size_ || count > size_ - offset) {
+        throw Error(Status::truncated_file, label_ + ": " + std::to_string(count) +
+                                                " bytes at byte " + std::to_string(offset) +
+                                                " pass the end of the file (" +
+                                                std::to_string(size_) + " bytes)");
+    }
+    auto* dst = static_cast<unsigned char*>(out);
+    std::size_t done = 0;
+    while (done < count) {
+        // pread moves at most about 2 GiB per call on Linux.
+        const std::size_t chunk = std::min<std::size_t>(count - done, std::size_t{1} << 30);
+        const ::ssize_t n = ::pread(fd_, dst + done, chunk, static_cast<::off_t>(offset + done));
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            throw Error(Status::io_error, label_ + ": read error at byte " +
+                                              std::to_string(offset + done) + ": " +
+                                              errno_text(errno));
+        }
+        if (n == 0) {
+            throw Error(Status::truncated_file,
+                        label_ + ": the file ended at byte " + std::to_string(offset + done) +
+                            " although it had " + std::to_string(size_) +
+                            " bytes when opened (was it changed while being read?)");
+        }
+        done += static_cast<std::size_t>(n);
+    }
+}
+
+std::string InputFile::read_string(std::uint64_t offset, std::uint64_t max_count) const
+{
+    if (offset >= size_) return {};
+    const std::uint64_t count = std::min(max_count, size_ - offset);
+    if (count > std::numeric_limits<std::size_t>::max() / 2) {
+        throw Error(Status::too_large,
+                    label_ + ": " + std::to_string(count) + " bytes cannot be held in memory");
+    }
+    std::string bytes(static_cast<std::size_t>(count), '\0');
+    read(offset, bytes.data(), bytes.size());
+    return bytes;
+}
+
+// ---- ByteSource -----------------------------------------------------------------------------
+
+bool ByteSource::take(std::size_t count, std::string_view& out) noexcept
+{
+    if (count > remaining()) return false;
+    out = bytes_.substr(pos_, count);
+    pos_ += count;
+    return true;
+}
+
+bool ByteSource::next_line(std::string_view& line, bool& terminated) noexcept
+{
+    if (at_end()) return false;
+    const std::size_t end = bytes_.find('\n', pos_);
+    terminated = end != std::string_view::npos;
+    const std::size_t stop = terminated ? end : bytes_.size();
+    line = bytes_.substr(pos_, stop - pos_);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    pos_ = terminated ? end + 1 : stop;
+    return true;
+}
+
+// ---- byte order -----------------------------------------------------------------------------
+
+Endian native_endian() noexcept
+{
+    return std::endian::native == std::endian::big ? Endian::big : Endian::little;
+}
+
+namespace {
+
+template <class U, U (*Swap)(U)> void swap_all(std::byte* data, std::size_t count) noexcept
+{
+    // memcpy keeps this free of alignment assumptions; compilers turn the loop into vector code.
+    for (std::size_t i = 0; i < count; ++i) {
+        U value;
+        std::memcpy(&value, data + i * sizeof(U), sizeof(U));
+        value = Swap(value);
+        std::memcpy(data + i * sizeof(U), &value, sizeof(U));
+    }
+}
+
+std::uint16_t swap16(std::uint16_t v)
+{
+    return __builtin_bswap16(v);
+}
+std::uint32_t swap32(std::uint32_t v)
+{
+    return __builtin_bswap32(v);
+}
+std::uint64_t swap64(std::uint64_t v)
+{
+    return __builtin_bswap64(v);
+}
+
+} // namespace
+
+void swap_bytes(std::byte* data, std::size_t count, std::size_t width) noexcept
+{
+    switch (width) {
+    case 2: swap_all<std::uint16_t, swap16>(data, count); break;
+    case 4: swap_all<std::uint32_t, swap32>(data, count); break;
+    case 8: swap_all<std::uint64_t, swap64>(data, count); break;
+    default: break;
+    }
+}
+
+// ---- zlib / gzip ----------------------------------------------------------------------------
+
+void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const std::string& label,
+                         const std::string& what)
+{
+    // A deflate block codes at most 258 bytes per 2 bits, hence about 1032:1; 1024 covers headers.
+    constexpr std::uint64_t kRatio = 1032;
+    constexpr std::uint64_t kSlack = 1024;
+    const bool possible =
+        compressed > (std::numeric_limits<std::uint64_t>::max() - kSlack) / kRatio ||
+        declared <= compressed * kRatio + kSlack;
+    if (!possible) {
+        throw Error(Status::truncated_file,
+                    label + ": " + what + " (" + std::to_string(declared) +
+                        " bytes) cannot come out of the " + std::to_string(compressed) +
+                        " compressed bytes in the file (deflate expands at most 1032:1); "
+                        "the header's sizes are wrong or the file was cut short");
+    }
+}
+
+namespace {
+
+/// Pulls bytes out of the stream(s) in `in`, one caller buffer at a time.
+class Inflater {
+public:
+    Inflater(std::string_view in, const std::string& label) : in_(in), label_(label)
+    {
+        // 15 + 32: a 32 KiB window, and a zlib or gzip header recognised automatically.
+        const int status = inflateInit2(&z_, 15 + 32);
+        if (status != Z_OK) {
+            throw Error(status == Z_MEM_ERROR ? Status::too_large : Status::internal,
+                        label_ + ": cannot start zlib inflate (" + std::to_string(status) + ")");
+        }
+    }
+    ~Inflater() { inflateEnd(&z_); }
+    Inflater(const Inflater&) = delete;
+    Inflater& operator=(const Inflater&) = delete;
+
+    /// Writes up to `count` bytes to `out`; fewer only when the input ended (then `ended()` says
+    /// whether the stream was complete). Returns how many were written.
+    std::size_t produce(unsigned char* out, std::size_t count)
+    {
+        std::size_t done = 0;
+        while (done < count) {
+            if (ended_) {
+                // A gzip file may hold several members one after the other: continue into the next.
+                const std::string_view rest = in_.substr(consumed());
+                if (rest.size() < 2 || static_cast<unsigned char>(rest[0]) != 0x1f ||
+                    static_cast<unsigned char>(rest[1]) != 0x8b) {
+                    break;
+                }
+                inflateReset(&z_);
+                ended_ = false;
+            }
+            if (z_.avail_in == 0) {
+                if (fed_ == in_.size()) break;
+                const std::size_t n = std::min<std::size_t>(in_.size() - fed_, kMaxChunk);
+                z_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in_.data() + fed_));
+                z_.avail_in = static_cast<uInt>(n);
+                fed_ += n;
+            }
+            const std::size_t room = std::min<std::size_t>(count - done, kMaxChunk);
+            z_.next_out = out + done;
+            z_.avail_out = static_cast<uInt>(room);
+            const int status = inflate(&z_, Z_NO_FLUSH);
+            done += room - z_.avail_out;
+            if (status == Z_STREAM_END) {
+                ended_ = true;
+            } else if (status == Z_BUF_ERROR) {
+                // No progress possible: the input is used up (a full output is handled by the
+                // loop).
+                if (z_.avail_in == 0 && fed_ < in_.size()) continue;
+                break;
+            } else if (status == Z_DATA_ERROR) {
+                throw Error(Status::bad_format,
+                            label_ + ": corrupt compressed data near byte " +
+                                std::to_string(consumed()) + " of the " +
+                                std::to_string(in_.size()) +
+                                "-byte stream (zlib: " + (z_.msg ? z_.msg : "invalid data") + ")");
+            } else if (status == Z_NEED_DICT) {
+                throw Error(Status::unsupported_format,
+                            label_ + ": the compressed stream needs a preset dictionary");
+            } else if (status == Z_MEM_ERROR) {
+                throw Error(Status::too_large, label_ + ": zlib ran out of memory while inflating");
+            } else if (status != Z_OK) {
+                throw Error(Status::internal,
+                            label_ + ": zlib inflate returned " + std::to_string(status));
+            }
+        }
+        return done;
+    }
+
+    bool ended() const noexcept { return ended_; }
+    std::size_t consumed() const noexcept { return fed_ - z_.avail_in; }
+
+private:
+    static constexpr std::size_t kMaxChunk = std::size_t{1} << 30; // zlib counts in 32-bit uInt
+    z_stream z_{};
+    std::string_view in_;
+    const std::string& label_;
+    std::size_t fed_ = 0;
+    bool ended_ = false;
+};
+
+} // namespace
+
+void inflate_exact(std::string_view in, std::uint64_t skip, std::byte* out, std::size_t out_size,
+                   const std::string& label)
+{
+    Inflater inflater(in, label);
+    const std::uint64_t wanted = skip + out_size;
+    std::uint64_t got = 0;
+    auto fail_short = [&] {
+        if (inflater.ended()) {
+            throw Error(Status::truncated_file,
+                        label + ": the compressed stream holds only " + std::to_string(got) +
+                            " bytes but the header declares " + std::to_string(wanted));
+        }
+        throw Error(Status::truncated_file,
+                    label + ": the compressed stream ends early, after " + std::to_string(got) +
+                        " of the " + std::to_string(wanted) + " declared bytes (file cut short?)");
+    };
+
+    std::array<unsigned char, 1 << 16> scratch{};
+    while (got < skip) {
+        const std::size_t n =
+            static_cast<std::size_t>(std::min<std::uint64_t>(skip - got, scratch.size()));
+        const std::size_t made = inflater.produce(scratch.data(), n);
+        got += made;
+        if (made < n) fail_short();
+    }
+    const std::size_t made = inflater.produce(reinterpret_cast<unsigned char*>(out), out_size);
+    got += made;
+    if (made < out_size) fail_short();
+
+    // Everything declared is there; the stream must now end (its trailer holds the checksum).
+    if (!inflater.ended()) {
+        if (inflater.produce(scratch.data(), 1) != 0) {
+            throw Error(Status::bad_format, label + ": the compressed stream holds more than the " +
+                                                std::to_string(wanted) +
+                                                " bytes the header declares");
+        }
+        if (!inflater.ended()) {
+            throw Error(Status::truncated_file,
+                        label + ": the compressed stream ends before its end marker and "
+                                "checksum (file cut short?)");
+        }
+    }
+    const std::string_view rest = in.substr(inflater.consumed());
+    const std::size_t junk = rest.find_first_not_of('\0');
+    if (junk != std::string_view::npos) {
+        throw Error(Status::bad_format,
+                    label + ": " + std::to_string(rest.size() - junk) +
+                        " bytes that are not zero padding follow the end of the compressed "
+                        "stream (at byte " +
+                        std::to_string(inflater.consumed() + junk) + " of " +
+                        std::to_string(in.size()) + ")");
+    }
+}
+
+} // namespace cmc33::io::detail

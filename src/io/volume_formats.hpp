@@ -1,0 +1,140 @@
+#pragma once
+// Internal: the volume formats behind io::read_volume / io::write_volume (include/cmc33/io.hpp),
+// and the helpers they share (defined in volume_io.cpp).
+//
+// A reader parses its header into a `Grid` (type, dims, spacing, origin) and a `Storage` (where
+// the samples are and how they are coded), then read_samples() checks the declared size against
+// the bytes the file holds *before* allocating the volume, reads or inflates the samples straight
+// into it and converts them to the machine's byte order.
+//
+// Messages start with `label`: the file as the user named it, then ": data file X" when the
+// samples are in a second file, then ": " and what is wrong.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <sstream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/volume.hpp"
+#include "io/byte_source.hpp"
+
+namespace cmc33::io::detail {
+
+/// Headers longer than this are refused (real ones are a few hundred bytes).
+constexpr std::size_t kMaxHeaderBytes = std::size_t{1} << 20;
+
+// ---- messages and text ----------------------------------------------------------------------
+
+/// Concatenates anything `ostream <<` accepts.
+template <class... Parts> std::string str_cat(const Parts&... parts)
+{
+    std::ostringstream s;
+    (s << ... << parts);
+    return s.str();
+}
+
+/// `text` in double quotes, non-printable bytes as \xNN, cut after `max_chars` characters.
+std::string quote_bytes(std::string_view text, std::size_t max_chars = 40);
+/// Without leading and trailing blanks (space, tab, CR, LF, VT, FF).
+std::string_view trim(std::string_view text) noexcept;
+/// Blank-separated words.
+std::vector<std::string_view> split_words(std::string_view text);
+/// Words joined by one space (collapses runs of blanks).
+std::string normalize_blanks(std::string_view text);
+std::string lower_ascii(std::string_view text);
+bool equals_ignore_case(std::string_view a, std::string_view b) noexcept;
+/// Shortest decimal that reads back as exactly `value`.
+std::string format_real(double value);
+/// "64x64x93".
+std::string dims_text(const Index3& dims);
+
+/// The whole token is a decimal number (a leading '+' is accepted; "nan", "inf" too).
+bool parse_real(std::string_view token, double& value);
+/// The whole token is a decimal integer (a leading '+' is accepted).
+bool parse_integer(std::string_view token, std::int64_t& value);
+
+// ---- header values --------------------------------------------------------------------------
+
+/// Three sample counts (`what` names the field in messages). Each must be an integer >= 2.
+/// @throws Error{bad_format} (not 3 words, not integers, < 2) or Error{too_large}.
+Index3 parse_dims(const std::vector<std::string_view>& words, const std::string& label,
+                  std::string_view what);
+/// Three finite numbers; with `positive`, each must be > 0 (spacings).
+Vec3 parse_vec3(const std::vector<std::string_view>& words, const std::string& label,
+                std::string_view what, bool positive);
+
+/// Bytes of dims[0]*dims[1]*dims[2] samples of `type`. Each axis must hold >= 2 samples.
+/// @throws Error{bad_format} for an axis < 2, Error{too_large} if the size overflows.
+std::uint64_t payload_bytes(const Index3& dims, ScalarType type, const std::string& label);
+
+/// The start of `file` (at most kMaxHeaderBytes), for parsing a header.
+/// @throws Error{truncated_file} for an empty file (`format` names what was expected).
+std::string read_header_bytes(const InputFile& file, std::string_view format);
+
+/// `name` from a header, relative to the header's folder unless absolute.
+std::filesystem::path resolve_data_file(const std::filesystem::path& header, std::string_view name);
+/// True for the multi-file form "<printf pattern> <min> <max> <step> [<axis>]" (NRRD, MetaImage).
+bool is_file_pattern(std::string_view value);
+
+// ---- samples --------------------------------------------------------------------------------
+
+/// What a header says about the samples' type and place in space.
+struct Grid {
+    ScalarType type = ScalarType::u8;
+    Index3 dims{0, 0, 0};
+    Vec3 spacing{1, 1, 1};
+    Vec3 origin{0, 0, 0};
+};
+
+enum class Encoding {
+    raw,        ///< the bytes as they are
+    compressed, ///< one zlib or gzip stream (detected from its first bytes)
+    ascii,      ///< decimal numbers separated by blanks
+};
+
+/// Where the samples are in their file and how they are coded.
+struct Storage {
+    Encoding encoding = Encoding::raw;
+    Endian endian = Endian::little;
+    std::uint64_t offset = 0;                 ///< first byte of the stored samples
+    bool at_end = false;                      ///< raw: the samples are the file's last bytes
+    std::optional<std::uint64_t> stored_size; ///< compressed: the stream's bytes, if declared
+    std::uint64_t skip_inflated = 0;          ///< compressed: output bytes to discard first
+};
+
+/// Reads the samples `grid` declares from `file` as `storage` says. Checks the sizes against the
+/// file before allocating. `label` starts the messages.
+Volume read_samples(const InputFile& file, const Grid& grid, const Storage& storage,
+                    const std::string& label);
+
+/// Fills `volume` from decimal text; the last value must be followed by a blank.
+/// @throws Error{truncated_file} (too few values), Error{bad_format} (not a number, out of range).
+void parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label);
+
+/// Writes the samples in `endian` order (in blocks, swapping a copy when needed).
+void write_samples(std::ostream& out, const Volume& volume, Endian endian);
+
+// ---- formats --------------------------------------------------------------------------------
+
+Volume read_nrrd(const std::filesystem::path& path, const std::string& label);
+Volume read_metaimage(const std::filesystem::path& path, const std::string& label);
+Volume read_vtk(const std::filesystem::path& path, const std::string& label);
+Volume read_raw(const std::filesystem::path& path, const std::string& label,
+                const std::optional<RawOptions>& raw);
+
+/// The data file a detached header names: "<stem>.raw" in the header's folder.
+std::filesystem::path data_file_beside(const std::filesystem::path& header);
+
+void write_nrrd(const Volume& volume, const std::filesystem::path& path, bool detached);
+void write_metaimage(const Volume& volume, const std::filesystem::path& path, bool local);
+void write_vtk(const Volume& volume, const std::filesystem::path& path);
+void write_raw(const Volume& volume, const std::filesystem::path& path);
+
+} // namespace cmc33::io::detail

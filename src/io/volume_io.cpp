@@ -1,0 +1,576 @@
+// Volume I/O: the choice of format by extension, and what the formats share: header values,
+// size checks, reading samples (raw, compressed, ASCII) into a volume, writing samples.
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+#include "cmc33/io.hpp"
+#include "io/atomic_file.hpp"
+#include "io/byte_source.hpp"
+#include "io/volume_formats.hpp"
+
+namespace cmc33::io {
+namespace detail {
+
+// ---- messages and text ----------------------------------------------------------------------
+
+namespace {
+
+bool is_blank(char c) noexcept
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
+}
+
+} // namespace
+
+std::string quote_bytes(std::string_view text, std::size_t max_chars)
+{
+    std::string out = "\"";
+    const std::size_t n = std::min(text.size(), max_chars);
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c >= 0x20 && c < 0x7f && c != '"' && c != '\\') {
+            out += static_cast<char>(c);
+        } else {
+            static constexpr char kHex[] = "0123456789abcdef";
+            out += "\\x";
+            out += kHex[c >> 4];
+            out += kHex[c & 15];
+        }
+    }
+    if (text.size() > n) out += "...";
+    out += '"';
+    return out;
+}
+
+std::string_view trim(std::string_view text) noexcept
+{
+    while (!text.empty() && is_blank(text.front())) text.remove_prefix(1);
+    while (!text.empty() && is_blank(text.back())) text.remove_suffix(1);
+    return text;
+}
+
+std::vector<std::string_view> split_words(std::string_view text)
+{
+    std::vector<std::string_view> words;
+    std::size_t i = 0;
+    while (i < text.size()) {
+        while (i < text.size() && is_blank(text[i])) ++i;
+        const std::size_t start = i;
+        while (i < text.size() && !is_blank(text[i])) ++i;
+        if (i > start) words.push_back(text.substr(start, i - start));
+    }
+    return words;
+}
+
+std::string normalize_blanks(std::string_view text)
+{
+    std::string out;
+    for (std::string_view word : split_words(text)) {
+        if (!out.empty()) out += ' ';
+        out += word;
+    }
+    return out;
+}
+
+std::string lower_ascii(std::string_view text)
+{
+    std::string out(text);
+    for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return out;
+}
+
+bool equals_ignore_case(std::string_view a, std::string_view b) noexcept
+{
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        if (std::tolower(static_cast<unsigned char>(a[i])) !=
+            std::tolower(static_cast<unsigned char>(b[i]))) {
+            return false;
+        }
+    }
+    return true;
+}
+
+std::string format_real(double value)
+{
+    std::array<char, 64> buffer{};
+    const auto result = std::to_chars(buffer.data(), buffer.data() + buffer.size(), value);
+    return std::string(buffer.data(), result.ptr);
+}
+
+std::string dims_text(const Index3& dims)
+{
+    return str_cat(dims[0], 'x', dims[1], 'x', dims[2]);
+}
+
+namespace {
+
+std::string_view without_leading_plus(std::string_view token) noexcept
+{
+    if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+')
+        token.remove_prefix(1);
+    return token;
+}
+
+enum class Parsed { ok, not_number, out_of_range };
+
+/// A whole-token decimal of floating type F. Underflow gives the nearest value (0 or subnormal),
+/// overflow is out_of_range.
+template <class F> Parsed parse_floating(std::string_view token, F& value)
+{
+    token = without_leading_plus(token);
+    const char* end = token.data() + token.size();
+    F parsed{};
+    const auto result = std::from_chars(token.data(), end, parsed, std::chars_format::general);
+    if (result.ptr != end || token.empty()) return Parsed::not_number;
+    if (result.ec == std::errc()) {
+        value = parsed;
+        return Parsed::ok;
+    }
+    if (result.ec != std::errc::result_out_of_range) return Parsed::not_number;
+    // from_chars says out_of_range for underflow and overflow alike. The wider long double tells
+    // them apart (a rare path); beyond even its range, the exponent's sign does.
+    long double wide = 0;
+    const auto again = std::from_chars(token.data(), end, wide, std::chars_format::general);
+    if (again.ec == std::errc::result_out_of_range) {
+        const std::size_t e = token.find_first_of("eE");
+        if (e == std::string_view::npos || e + 1 >= token.size() || token[e + 1] != '-')
+            return Parsed::out_of_range;
+        wide = token.front() == '-' ? -0.0L : 0.0L;
+    } else if (again.ec != std::errc()) {
+        return Parsed::not_number;
+    }
+    if (!(std::fabs(wide) <= static_cast<long double>(std::numeric_limits<F>::max())))
+        return Parsed::out_of_range;
+    value = static_cast<F>(wide);
+    return Parsed::ok;
+}
+
+Parsed parse_int64(std::string_view token, std::int64_t& value)
+{
+    token = without_leading_plus(token);
+    const char* end = token.data() + token.size();
+    std::int64_t parsed = 0;
+    const auto result = std::from_chars(token.data(), end, parsed);
+    if (result.ptr != end || token.empty()) return Parsed::not_number;
+    if (result.ec == std::errc::result_out_of_range) return Parsed::out_of_range;
+    if (result.ec != std::errc()) return Parsed::not_number;
+    value = parsed;
+    return Parsed::ok;
+}
+
+} // namespace
+
+bool parse_real(std::string_view token, double& value)
+{
+    return parse_floating(token, value) == Parsed::ok;
+}
+
+bool parse_integer(std::string_view token, std::int64_t& value)
+{
+    return parse_int64(token, value) == Parsed::ok;
+}
+
+// ---- header values --------------------------------------------------------------------------
+
+Index3 parse_dims(const std::vector<std::string_view>& words, const std::string& label,
+                  std::string_view what)
+{
+    if (words.size() != 3) {
+        throw Error(Status::bad_format, str_cat(label, ": ", what, " has ", words.size(),
+                                                " values, expected 3 (samples along x, y, z)"));
+    }
+    Index3 dims{};
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        std::int64_t n = 0;
+        const Parsed parsed = parse_int64(words[axis], n);
+        if (parsed == Parsed::out_of_range && words[axis].front() != '-') {
+            throw Error(Status::too_large,
+                        str_cat(label, ": ", what, " value ", quote_bytes(words[axis]),
+                                " is too large (more than 2^63 samples)"));
+        }
+        if (parsed != Parsed::ok || n <= 0) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": ", what, " value ", quote_bytes(words[axis]),
+                                " is not a positive integer"));
+        }
+        dims[axis] = n;
+    }
+    return dims;
+}
+
+Vec3 parse_vec3(const std::vector<std::string_view>& words, const std::string& label,
+                std::string_view what, bool positive)
+{
+    if (words.size() != 3) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": ", what, " has ", words.size(), " values, expected 3"));
+    }
+    Vec3 v{};
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        if (!parse_real(words[axis], v[axis])) {
+            throw Error(Status::bad_format, str_cat(label, ": ", what, " value ",
+                                                    quote_bytes(words[axis]), " is not a number"));
+        }
+        if (!std::isfinite(v[axis])) {
+            throw Error(Status::non_finite, str_cat(label, ": ", what, " value ",
+                                                    quote_bytes(words[axis]), " is not finite"));
+        }
+        if (positive && !(v[axis] > 0)) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": ", what, " value ", quote_bytes(words[axis]),
+                                " is not positive; spacings must be > 0"));
+        }
+    }
+    return v;
+}
+
+std::uint64_t payload_bytes(const Index3& dims, ScalarType type, const std::string& label)
+{
+    for (std::int64_t d : dims) {
+        if (d < 2) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": sizes ", dims_text(dims),
+                                ": an isosurface needs at least 2 samples on each axis"));
+        }
+    }
+    std::uint64_t bytes = type_size(type);
+    for (std::int64_t d : dims) {
+        const auto n = static_cast<std::uint64_t>(d);
+        if (bytes > std::numeric_limits<std::uint64_t>::max() / n) {
+            throw Error(Status::too_large, str_cat(label, ": sizes ", dims_text(dims), " of ",
+                                                   type_name(type), " samples overflow 64 bits"));
+        }
+        bytes *= n;
+    }
+    if (bytes > static_cast<std::uint64_t>(std::numeric_limits<std::ptrdiff_t>::max())) {
+        throw Error(Status::too_large,
+                    str_cat(label, ": sizes ", dims_text(dims), " of ", type_name(type),
+                            " samples need ", bytes, " bytes, more than memory can address"));
+    }
+    return bytes;
+}
+
+std::string read_header_bytes(const InputFile& file, std::string_view format)
+{
+    if (file.size() == 0) {
+        throw Error(
+            Status::truncated_file,
+            str_cat(file.label(), ": the file is empty (0 bytes), expected a ", format, " header"));
+    }
+    return file.read_string(0, kMaxHeaderBytes);
+}
+
+std::filesystem::path resolve_data_file(const std::filesystem::path& header, std::string_view name)
+{
+    const std::filesystem::path data{std::string(name)};
+    if (data.is_absolute()) return data;
+    return header.parent_path() / data;
+}
+
+bool is_file_pattern(std::string_view value)
+{
+    const std::vector<std::string_view> words = split_words(value);
+    if (words.size() < 4 || words.size() > 5 || words[0].find('%') == std::string_view::npos)
+        return false;
+    for (std::size_t i = 1; i < words.size(); ++i) {
+        std::int64_t n = 0;
+        if (!parse_integer(words[i], n)) return false;
+    }
+    return true;
+}
+
+// ---- samples --------------------------------------------------------------------------------
+
+namespace {
+
+Volume allocate(const Grid& grid, const std::string& label)
+{
+    try {
+        return Volume(grid.type, grid.dims, grid.spacing, grid.origin);
+    } catch (const Error& e) {
+        throw Error(e.status(), label + ": " + e.what());
+    }
+}
+
+std::string declared(const Grid& grid, std::uint64_t bytes)
+{
+    return str_cat("header declares ", dims_text(grid.dims), ' ', type_name(grid.type), " (", bytes,
+                   " bytes)");
+}
+
+template <class T> std::string range_text()
+{
+    if constexpr (std::is_floating_point_v<T>) {
+        return str_cat("+-", std::numeric_limits<T>::max());
+    } else {
+        return str_cat(+std::numeric_limits<T>::lowest(), "..", +std::numeric_limits<T>::max());
+    }
+}
+
+template <class T>
+void parse_ascii_typed(std::string_view text, T* out, std::int64_t count, ScalarType type,
+                       const std::string& label)
+{
+    std::size_t pos = 0;
+    const std::size_t size = text.size();
+    for (std::int64_t i = 0; i < count; ++i) {
+        while (pos < size && is_blank(text[pos])) ++pos;
+        if (pos == size) {
+            throw Error(Status::truncated_file,
+                        str_cat(label, ": the header declares ", count,
+                                " values but the data ends after ", i, " (file cut short?)"));
+        }
+        std::size_t end = pos;
+        while (end < size && !is_blank(text[end])) ++end;
+        const std::string_view token = text.substr(pos, end - pos);
+        if (end == size) {
+            if (i + 1 < count) {
+                throw Error(Status::truncated_file, str_cat(label, ": the header declares ", count,
+                                                            " values but the data ends after ",
+                                                            i + 1, " (file cut short?)"));
+            }
+            throw Error(Status::truncated_file,
+                        str_cat(label, ": the file ends inside a number: the last value ",
+                                quote_bytes(token),
+                                " is not followed by a blank or a newline (file cut short?)"));
+        }
+        Parsed parsed = Parsed::not_number;
+        if constexpr (std::is_floating_point_v<T>) {
+            parsed = parse_floating(token, out[i]);
+        } else {
+            std::int64_t n = 0;
+            parsed = parse_int64(token, n);
+            if (parsed == Parsed::ok) {
+                if (n < static_cast<std::int64_t>(std::numeric_limits<T>::lowest()) ||
+                    n > static_cast<std::int64_t>(std::numeric_limits<T>::max())) {
+                    parsed = Parsed::out_of_range;
+                } else {
+                    out[i] = static_cast<T>(n);
+                }
+            } else if (parsed == Parsed::not_number) {
+                double real = 0;
+                if (parse_floating(token, real) == Parsed::ok) {
+                    throw Error(Status::bad_format,
+                                str_cat(label, ": value ", i + 1, " of ", count, ' ',
+                                        quote_bytes(token), " is not an integer, expected ",
+                                        type_name(type), " values"));
+                }
+            }
+        }
+        if (parsed == Parsed::out_of_range) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": value ", i + 1, " of ", count, ' ', quote_bytes(token),
+                                " is out of the ", type_name(type), " range ", range_text<T>()));
+        }
+        if (parsed != Parsed::ok) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": value ", i + 1, " of ", count, ' ', quote_bytes(token),
+                                " is not a number, expected ", type_name(type), " values"));
+        }
+        pos = end;
+    }
+}
+
+} // namespace
+
+void parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label)
+{
+    dispatch_scalar_type(volume.type(), [&](auto tag) {
+        using T = decltype(tag);
+        parse_ascii_typed<T>(text, volume.samples<T>(), volume.sample_count(), volume.type(),
+                             label);
+    });
+}
+
+Volume read_samples(const InputFile& file, const Grid& grid, const Storage& storage,
+                    const std::string& label)
+{
+    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
+    const std::uint64_t size = file.size();
+    if (storage.offset > size) {
+        throw Error(Status::truncated_file,
+                    str_cat(label, ": the samples should start at byte ", storage.offset,
+                            " but the file has only ", size, " bytes (file cut short?)"));
+    }
+    const std::uint64_t available = size - storage.offset;
+    const std::size_t width = type_size(grid.type);
+
+    switch (storage.encoding) {
+    case Encoding::raw: {
+        if (available < bytes) {
+            throw Error(Status::truncated_file,
+                        str_cat(label, ": ", declared(grid, bytes), " but only ", available,
+                                " bytes follow byte ", storage.offset,
+                                " (file cut short, or wrong sizes?)"));
+        }
+        const std::uint64_t offset = storage.at_end ? size - bytes : storage.offset;
+        Volume volume = allocate(grid, label);
+        file.read(offset, volume.bytes(), volume.byte_size());
+        to_native(volume.bytes(), static_cast<std::size_t>(volume.sample_count()), width,
+                  storage.endian);
+        return volume;
+    }
+    case Encoding::compressed: {
+        std::uint64_t stream = available;
+        if (storage.stored_size) {
+            if (*storage.stored_size > available) {
+                throw Error(Status::truncated_file,
+                            str_cat(label, ": the header declares ", *storage.stored_size,
+                                    " compressed bytes but only ", available, " follow byte ",
+                                    storage.offset,
+                                    " (file cut short, or wrong compressed size?)"));
+            }
+            stream = *storage.stored_size;
+        }
+        // Nothing of the declared size is allocated unless the stream could hold it.
+        check_inflate_bound(stream, storage.skip_inflated + bytes, label, declared(grid, bytes));
+        const std::string compressed = file.read_string(storage.offset, stream);
+        Volume volume = allocate(grid, label);
+        inflate_exact(compressed, storage.skip_inflated, volume.bytes(), volume.byte_size(), label);
+        to_native(volume.bytes(), static_cast<std::size_t>(volume.sample_count()), width,
+                  storage.endian);
+        return volume;
+    }
+    case Encoding::ascii: {
+        // Each value takes at least two bytes (a digit and a blank; the last one's blank is checked
+        // while parsing, to say "ends inside a number"): check before allocating.
+        const auto count = static_cast<std::uint64_t>(grid.dims[0]) *
+                           static_cast<std::uint64_t>(grid.dims[1]) *
+                           static_cast<std::uint64_t>(grid.dims[2]);
+        if (count > available / 2 + 1) {
+            throw Error(Status::truncated_file,
+                        str_cat(label, ": the header declares ", dims_text(grid.dims), " = ", count,
+                                " ASCII values but only ", available,
+                                " bytes of data follow; each value takes at "
+                                "least 2 (file cut short, or wrong sizes?)"));
+        }
+        const std::string text = file.read_string(storage.offset, available);
+        Volume volume = allocate(grid, label);
+        parse_ascii_samples(text, volume, label);
+        return volume;
+    }
+    }
+    throw Error(Status::internal, label + ": unknown sample encoding");
+}
+
+void write_samples(std::ostream& out, const Volume& volume, Endian endian)
+{
+    const std::size_t width = type_size(volume.type());
+    const auto* data = reinterpret_cast<const char*>(volume.bytes());
+    const std::size_t total = volume.byte_size();
+    if (width == 1 || endian == native_endian()) {
+        out.write(data, static_cast<std::streamsize>(total));
+        return;
+    }
+    constexpr std::size_t kBlock = std::size_t{1} << 20; // a multiple of every sample size
+    std::vector<std::byte> block(std::min(total, kBlock));
+    for (std::size_t done = 0; done < total;) {
+        const std::size_t n = std::min(kBlock, total - done);
+        std::memcpy(block.data(), data + done, n);
+        swap_bytes(block.data(), n / width, width);
+        out.write(reinterpret_cast<const char*>(block.data()), static_cast<std::streamsize>(n));
+        done += n;
+    }
+}
+
+} // namespace detail
+
+// ---- public API -----------------------------------------------------------------------------
+
+ScalarType parse_type(const std::string& name)
+{
+    struct Name {
+        std::string_view text;
+        ScalarType type;
+    };
+    static constexpr std::array<Name, 16> kNames{{
+        {"int8", ScalarType::i8},
+        {"uint8", ScalarType::u8},
+        {"int16", ScalarType::i16},
+        {"uint16", ScalarType::u16},
+        {"int32", ScalarType::i32},
+        {"uint32", ScalarType::u32},
+        {"float", ScalarType::f32},
+        {"double", ScalarType::f64},
+        {"char", ScalarType::i8},
+        {"uchar", ScalarType::u8},
+        {"short", ScalarType::i16},
+        {"ushort", ScalarType::u16},
+        {"int", ScalarType::i32},
+        {"uint", ScalarType::u32},
+        {"float32", ScalarType::f32},
+        {"float64", ScalarType::f64},
+    }};
+    const std::string key = detail::lower_ascii(detail::trim(name));
+    for (const Name& n : kNames) {
+        if (n.text == key) return n.type;
+    }
+    throw Error(Status::invalid_argument,
+                "unknown sample type " + detail::quote_bytes(name) +
+                    "; expected one of int8, uint8, int16, uint16, int32, uint32, float, double "
+                    "(or char, uchar, short, ushort, int, uint, float32, float64)");
+}
+
+bool has_volume_header(const std::filesystem::path& path)
+{
+    const std::string ext = detail::lower_extension(path);
+    return ext == ".nrrd" || ext == ".nhdr" || ext == ".mhd" || ext == ".mha" || ext == ".vtk";
+}
+
+Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw)
+{
+    const std::string label = path.string();
+    const std::string ext = detail::lower_extension(path);
+    if (ext == ".nrrd" || ext == ".nhdr") return detail::read_nrrd(path, label);
+    if (ext == ".mhd" || ext == ".mha") return detail::read_metaimage(path, label);
+    if (ext == ".vtk") return detail::read_vtk(path, label);
+    return detail::read_raw(path, label, raw);
+}
+
+void write_volume(const Volume& volume, const std::filesystem::path& path)
+{
+    const std::string label = path.string();
+    if (volume.bytes() == nullptr || volume.sample_count() <= 0) {
+        throw Error(Status::invalid_argument,
+                    label + ": cannot write an empty volume (it holds no samples)");
+    }
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        if (!std::isfinite(volume.spacing()[axis]) || !std::isfinite(volume.origin()[axis])) {
+            throw Error(Status::non_finite,
+                        detail::str_cat(label,
+                                        ": cannot write a volume whose spacing or origin "
+                                        "is not finite (axis ",
+                                        axis, ")"));
+        }
+        if (!(volume.spacing()[axis] > 0)) {
+            throw Error(Status::invalid_argument,
+                        detail::str_cat(label, ": cannot write spacing ", volume.spacing()[axis],
+                                        " on axis ", axis, "; spacings must be > 0"));
+        }
+    }
+    const std::string ext = detail::lower_extension(path);
+    if (ext == ".nrrd" || ext == ".nhdr") {
+        detail::write_nrrd(volume, path, ext == ".nhdr");
+    } else if (ext == ".mhd" || ext == ".mha") {
+        detail::write_metaimage(volume, path, ext == ".mha");
+    } else if (ext == ".vtk") {
+        detail::write_vtk(volume, path);
+    } else if (ext == ".raw") {
+        detail::write_raw(volume, path);
+    } else {
+        throw Error(Status::unsupported_format,
+                    label + ": cannot write volume format " +
+                        (ext.empty() ? "(no extension)" : "\"" + ext + "\"") +
+                        "; accepted extensions: .nrrd .nhdr .mhd .mha .vtk .raw");
+    }
+}
+
+} // namespace cmc33::io
