@@ -38,8 +38,11 @@ MeshTopology mesh_topology(const Mesh& mesh);
 /// Invariants of S = {x : f(x) = iso} inside the grid's box, f the piecewise-trilinear
 /// interpolant of the samples, computed from the samples alone (no mesh, nothing shared with the
 /// extractor). The sign rule applies: a value equal to iso counts as above, i.e. S is the level
-/// set at iso - epsilon. `determined` is false when refinement could not settle a cell (a saddle
-/// within rounding of iso); the numbers are then meaningless and `why` says which cell.
+/// set at iso - epsilon. Every decision (face saddles, interior connectivity by a sweep of the
+/// cell, see src/topology/field_topology.cpp) is made exactly, so ties and near-ties are settled.
+/// `determined` is false only when the exact arithmetic lost range (values - iso with magnitudes
+/// beyond about 2^+-200) or the independent refinement cross-check disagreed with the exact
+/// analysis (a bug); the numbers are then meaningless and `why` says which cell and why.
 struct FieldTopology {
     bool determined = false;
     std::string why;
@@ -51,7 +54,10 @@ struct FieldTopology {
 };
 
 struct FieldTopologyOptions {
-    int max_refinement = 256; ///< largest subdivision factor tried for one cell
+    /// Cross-check each cell with two or more loops by adaptive 2x2x2 refinement down to
+    /// 1/max_refinement of a cell (at most 1024; below 2, no cross-check). Near-ties never settle
+    /// by refinement; there the exact analysis stands alone.
+    int max_refinement = 256;
 };
 
 template <class T>
