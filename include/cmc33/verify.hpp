@@ -1,0 +1,203 @@
+#pragma once
+/// @file verify.hpp
+/// The topology stress test (Etiene et al. 2012; Custodio et al. 2013, Sec. 4): random fields,
+/// the topology their trilinear level set must have (field_topology), the topology of the mesh a
+/// method extracts (mesh_topology), and the comparison. Also the public verification dataset:
+/// the same fields written as NRRD files with their expected invariants, to judge any extractor.
+/// docs/verification.md explains what is compared and why.
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/topology.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33 {
+
+/// The three families of random fields.
+///  - cell:   2x2x2 samples from a mix of distributions that covers all 256 sign configurations
+///            and all 33 subcases (docs/verification.md lists them);
+///  - grid:   size^3 samples uniform in [-1, 1] (the paper's 5x5x5 grids);
+///  - closed: size^3 samples, those with an index 0 or size - 1 in [-1, -0.1] (below iso 0, so
+///            every surface is closed), the others uniform in [-1, 1].
+/// The isovalue is 0 for all of them.
+enum class FieldKind { cell, grid, closed };
+inline constexpr int kFieldKindCount = 3;
+
+std::string_view field_kind_name(FieldKind kind) noexcept; ///< "cell", "grid", "closed"
+
+/// Item n (n >= 1) of kind `kind` in a run with seed `seed`: float samples, spacing 1, origin 0.
+/// Each item has its own generator, seeded from (seed, kind, n) (SplitMix64), so a field does not
+/// depend on the thread count, the order of work or the other items of the run.
+/// @param size  samples per axis of grid and closed fields (ignored for cells)
+/// @throws Error{invalid_argument} if n < 1 or size < 2 (size < 3 for closed: no interior sample)
+Volume random_field(FieldKind kind, std::int64_t n, std::uint64_t seed, int size = 5);
+
+/// Name of the distribution cell n is drawn from ("uniform", "cubed", "pattern", ...).
+std::string_view cell_distribution_name(std::int64_t n) noexcept;
+
+/// "cell-000042": the file stem of item n (six digits at least).
+std::string field_name(FieldKind kind, std::int64_t n);
+
+/// True iff the mesh has the field's euler, b0, b1, b2 and boundary loops. False if the field is
+/// undetermined. Manifoldness is not part of it: see is_manifold().
+bool topology_matches(const MeshTopology& mesh, const FieldTopology& field) noexcept;
+/// No non-manifold edge and no non-manifold vertex.
+bool is_manifold(const MeshTopology& mesh) noexcept;
+
+/// Where a long run is, for a progress line. Called on the thread that called verify(),
+/// about every 0.2 s, and once more at the end with done == total.
+struct VerifyProgress {
+    std::int64_t done = 0;       ///< fields finished
+    std::int64_t total = 0;      ///< fields in the run
+    std::int64_t mismatched = 0; ///< (field, method) pairs that did not match so far
+    double seconds = 0;          ///< since the run started
+};
+using ProgressCallback = std::function<void(const VerifyProgress&)>;
+
+struct VerifyOptions {
+    std::vector<Method> methods{Method::cmc33, Method::mc33_lewiner, Method::mc};
+    std::int64_t cells = 0;  ///< cell fields, items 1..cells
+    std::int64_t grids = 0;  ///< grid fields
+    std::int64_t closed = 0; ///< closed fields
+    int size = 5; ///< samples per axis of grid and closed fields, >= 2 (>= 3 with closed)
+    std::uint64_t seed = 1;
+    int threads = 0; ///< 0: all cores. Each extract() runs single-threaded.
+    /// Where failing fields go (created only if there is one); empty: nowhere. See verify().
+    std::filesystem::path failures_dir;
+    int max_failures = 20; ///< per method: the first ones in (kind, n) order
+    ProgressCallback progress;
+};
+
+/// Results of one method (or of the external command of verify_dataset).
+struct MethodReport {
+    std::string name; ///< method_name(method), or "command"
+    Method method = Method::cmc33;
+    bool external = false;         ///< an external command (verify_dataset)
+    std::int64_t checked = 0;      ///< fields compared (determined ones)
+    std::int64_t matched = 0;      ///< invariants equal and manifold
+    std::int64_t mismatched = 0;   ///< checked - matched (includes non-manifold and errors)
+    std::int64_t undetermined = 0; ///< fields field_topology could not settle: not compared
+    std::int64_t nonmanifold = 0;  ///< meshes with a non-manifold edge or vertex
+    std::int64_t unoriented = 0;   ///< meshes not consistently oriented (reported, not a mismatch)
+    std::int64_t errors = 0;       ///< extract threw, or the command failed (also mismatched)
+    std::array<std::int64_t, kFieldKindCount> checked_by_kind{};
+    std::array<std::int64_t, kFieldKindCount> mismatched_by_kind{};
+    /// Per subcase: fields that contain it, and of those the mismatching ones. A cell counts for
+    /// the subcase the method assigns it (analyze_cell); a grid counts for every subcase with a
+    /// face or interior test (3.x 4.x 6.x 7.x 10.x 12.x 13.x) that occurs among its cells.
+    std::array<std::int64_t, kSubcaseCount> fields_per_subcase{};
+    std::array<std::int64_t, kSubcaseCount> mismatches_per_subcase{};
+    std::int64_t failures_written = 0; ///< failing fields saved for this method
+};
+
+struct VerifyReport {
+    std::vector<MethodReport> methods;
+    std::array<std::int64_t, kFieldKindCount> fields{}; ///< fields run, per kind
+    std::array<double, kFieldKindCount> kind_seconds{}; ///< wall time per kind
+    std::uint64_t seed = 0;
+    int size = 0;
+    int threads = 0;                    ///< threads used
+    double seconds = 0;                 ///< wall time of the whole run
+    std::filesystem::path failures_dir; ///< empty if nothing was written
+    std::int64_t failures_written = 0;  ///< lines of failures.tsv
+
+    /// Fields per second of one kind (0 if none ran).
+    double rate(FieldKind kind) const noexcept;
+    /// No mismatch (hence no non-manifold mesh) for any method.
+    bool passed() const noexcept;
+};
+
+/// Runs the stress test. For every field: field_topology once, then for every method extract
+/// (threads = 1), mesh_topology and the comparison. Fields run in parallel; totals are the same
+/// for every thread count.
+///
+/// Failing fields (up to max_failures per method, the first in (kind, n) order) are written to
+/// failures_dir: `<kind>-<n>.nrrd` (float samples), `<kind>-<n>-<method>.ply` (the mesh) and one
+/// line each in `failures.tsv` (expected and obtained invariants, and the commands that reproduce
+/// the failure).
+/// @throws Error{invalid_argument} for a negative count, size < 2 (< 3 with closed fields), no
+///         method, or a repeated method; Error from the writers.
+VerifyReport verify(const VerifyOptions& options);
+
+// ------------------------------------------------------------------------------------------------
+// The public dataset.
+
+struct DatasetOptions {
+    std::int64_t cells = 10000;
+    std::int64_t grids = 10000;
+    std::int64_t closed = 1000;
+    std::uint64_t seed = 1;
+    int size = 5;
+    int threads = 0;
+    ProgressCallback progress;
+};
+
+struct DatasetSummary {
+    std::array<std::int64_t, kFieldKindCount> written{};      ///< files written, per kind
+    std::array<std::int64_t, kFieldKindCount> undetermined{}; ///< fields left out, per kind
+    double seconds = 0;
+};
+
+/// Writes `dir/cells/cell-000001.nrrd`, `dir/grids/grid-000001.nrrd`, `dir/closed/...` (float
+/// NRRD; the same fields verify() draws with the same seed), `dir/manifest.tsv` and
+/// `dir/README.txt`. Fields whose topology is undetermined are left out (their numbers are
+/// skipped). `dir` is created; it must not exist or be empty.
+/// @throws Error{invalid_argument} if dir holds files, for a negative count or a bad size;
+///         Error{io_error} from the writers.
+DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options);
+
+/// One line of manifest.tsv.
+struct ManifestEntry {
+    std::string file; ///< relative to the dataset folder, '/' separated
+    double iso = 0;
+    FieldTopology expected; ///< determined = true
+    std::string subcase;    ///< cmc33's subcase name for cells, "-" for other fields
+    int line = 0;           ///< line number in manifest.tsv
+};
+
+/// Reads `dir/manifest.tsv`. @throws Error{io_error} if it cannot be read, Error{bad_format}
+/// naming the file and the line for a line that does not parse.
+std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir);
+
+struct DatasetVerifyOptions {
+    std::vector<Method> methods{Method::cmc33}; ///< in-process extractors, if command is empty
+    /// An external extractor instead: a shell command with the placeholders {in} (the volume),
+    /// {iso} and {out} (the mesh to write). {out} is a fresh temporary path ending in .ply, unless
+    /// the template writes an extension right after it ("{out}.obj", ".off", ".ply", ".stl"), in
+    /// which case {out} is the path without extension. Paths are single-quoted for the shell.
+    std::string command;
+    int threads = 0;
+    std::filesystem::path failures_dir; ///< as in VerifyOptions
+    int max_failures = 20;
+    ProgressCallback progress;
+};
+
+/// Checks every manifest entry: extracts it (in-process, or by running the command with
+/// std::system and reading its mesh with io::read_mesh) and compares with the manifest's
+/// invariants. A command that exits non-zero or writes no readable mesh counts as a mismatch
+/// (MethodReport::errors; the reason is in failures.tsv). Subcases are counted as in verify()
+/// (a 2x2x2 field is a cell), under the method, or under cmc33 for a command. Kinds: a file named
+/// cell-* or with a subcase is a cell, closed-* a closed grid, anything else a grid.
+/// @throws Error from read_manifest and read_volume (a missing or broken dataset file).
+VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerifyOptions& options);
+
+/// A command line for one field, and the mesh file it writes.
+struct ExternalCommand {
+    std::string shell;            ///< for std::system
+    std::filesystem::path output; ///< the mesh file the command is expected to write
+};
+
+/// The template with {in}, {iso} and {out} replaced, every occurrence, paths single-quoted.
+/// {out} is `out_base` + ".ply", or `out_base` alone where the template writes ".ply", ".obj",
+/// ".off" or ".stl" right after it. @throws Error{invalid_argument} if {in} or {out} is missing.
+ExternalCommand expand_command(std::string_view command_template, const std::filesystem::path& in,
+                               double iso, const std::filesystem::path& out_base);
+
+} // namespace cmc33

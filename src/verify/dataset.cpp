@@ -1,0 +1,623 @@
+// The public verification dataset (the paper's Sec. 4.1 offers the same: "Marching Cubes cases
+// grids and randomly generated 5x5x5 grids" with their invariants): the fields of verify() as
+// NRRD files, a manifest of their expected invariants, and verify_dataset() to judge any
+// extractor against it, in-process or as an external command.
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <charconv>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <memory>
+#include <utility>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "cmc33/cell.hpp"
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/topology.hpp"
+#include "cmc33/verify.hpp"
+#include "core/parallel.hpp"
+#include "verify/verify_detail.hpp"
+
+namespace cmc33 {
+namespace {
+
+using verification::detail::number_text;
+using verification::detail::Outcome;
+using verification::detail::shell_quote;
+using verification::detail::Tally;
+
+constexpr std::string_view kManifestHeader =
+    "file\tiso\teuler\tb0\tb1\tb2\tboundary_loops\tsubcase";
+constexpr std::array<std::string_view, kFieldKindCount> kFolders = {"cells", "grids", "closed"};
+
+// README.txt of a dataset; @NAME@ fields are filled in by readme_text().
+constexpr std::string_view kReadme = R"(cmc33 verification dataset
+==========================
+
+Random scalar fields and the topology of the level set of their trilinear interpolant, to test
+whether an isosurface extractor is topologically correct (Etiene et al. 2012; Custodio et al.
+2013, Sec. 4). Written by `cmc33 dataset` with seed @SEED@.
+
+  cells/   @CELLS@ fields of 2x2x2 samples (one cell), drawn to cover all 256 sign configurations
+           and all 33 subcases of Marching Cubes 33
+  grids/   @GRIDS@ fields of @SIZE@ samples uniform in [-1, 1]
+  closed/  @CLOSED@ fields of @SIZE@ samples whose boundary samples are in [-1, -0.1], so every
+           surface is closed; the others uniform in [-1, 1]
+
+Every file is an NRRD volume (attached header, raw float32 in the byte order its header gives),
+x fastest, spacing 1. Fields whose topology the verifier could not decide are left out, so the
+numbering may have gaps: @LEFT_OUT@ were left out.
+
+manifest.tsv
+------------
+A header line, then one tab-separated line per file:
+  file            path relative to this folder
+  iso             the isovalue (0 for every field here)
+  euler           Euler characteristic of the surface S = {f = iso} inside the grid's box
+  b0 b1 b2        Betti numbers of S: components; b1 = b0 + b2 - euler (a component of genus g
+                  adds 2g if it is closed, 2g + k - 1 if it has k boundary curves); closed
+                  components
+  boundary_loops  closed curves in which S meets the box's faces
+  subcase         for cells, the Marching Cubes 33 subcase cmc33 assigns (Chernyaev's numbering,
+                  e.g. 13.5.2); '-' for grids
+
+f is the trilinear interpolant of the samples in every cell. The sign rule: a sample (or a face or
+interior saddle) equal to the isovalue counts as above it, i.e. S is the level set at
+iso - epsilon for an infinitesimal epsilon.
+
+How to use it
+-------------
+Extract a mesh from every file at its isovalue, compute the mesh's Euler characteristic
+(V - E + F), its components, closed components and boundary loops, b1 = b0 + b2 - euler, and
+compare with the manifest. A topologically correct extractor matches every line with a manifold
+mesh (every edge in two triangles, or one on the box's faces; every vertex one fan). With cmc33:
+
+  cmc33 verify --dataset DIR --method cmc33       # cmc33 itself
+  cmc33 verify --dataset DIR --cmd 'mytool {in} {iso} {out}'
+
+The command runs for every file, with {in} the volume, {iso} the isovalue and {out} the mesh to
+write (.ply; write {out}.obj or {out}.off to choose another format). Do not quote the
+placeholders: cmc33 quotes the paths.
+`cmc33 verify @ARGS@` checks the same fields without files.
+)";
+
+std::string readme_text(const DatasetOptions& options, const DatasetSummary& summary)
+{
+    const std::string size = std::to_string(options.size);
+    const std::string cube = size + "x" + size + "x" + size;
+    const std::pair<std::string_view, std::string> fields[] = {
+        {"@SEED@", std::to_string(options.seed)},
+        {"@CELLS@", std::to_string(summary.written[0])},
+        {"@GRIDS@", std::to_string(summary.written[1])},
+        {"@CLOSED@", std::to_string(summary.written[2])},
+        {"@SIZE@", cube},
+        {"@LEFT_OUT@", std::to_string(summary.undetermined[0]) + " cells, " +
+                           std::to_string(summary.undetermined[1]) + " grids and " +
+                           std::to_string(summary.undetermined[2]) + " closed grids"},
+        {"@ARGS@", "--seed " + std::to_string(options.seed) + " --cells " +
+                       std::to_string(options.cells) + " --grids " + std::to_string(options.grids) +
+                       " --closed " + std::to_string(options.closed) + " --size " + size},
+    };
+    std::string text(kReadme);
+    for (const auto& [key, value] : fields) {
+        for (std::size_t at; (at = text.find(key)) != std::string::npos;)
+            text.replace(at, key.size(), value);
+    }
+    return text;
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text)
+{
+    const std::filesystem::path tmp = path.string() + ".tmp";
+    {
+        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+        out << text;
+        out.flush();
+        if (!out) throw Error(Status::io_error, tmp.string() + ": cannot write");
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, path, ec);
+    if (ec)
+        throw Error(Status::io_error,
+                    path.string() + ": cannot rename " + tmp.string() + " to it: " + ec.message());
+}
+
+std::array<double, 8> corner_values(const Volume& volume)
+{
+    std::array<double, 8> v{};
+    volume.visit([&](auto view) {
+        for (int c = 0; c < 8; ++c)
+            v[static_cast<std::size_t>(c)] =
+                static_cast<double>(view(c & 1, c >> 1 & 1, c >> 2 & 1));
+    });
+    return v;
+}
+
+bool is_cell(const Volume& volume)
+{
+    return volume.dims() == Index3{2, 2, 2};
+}
+
+/// The subcases a field counts for under `method` (see MethodReport).
+std::vector<int> subcases_of(const Volume& volume, double iso, Method method,
+                             const ExtractStats* stats)
+{
+    std::vector<int> out;
+    if (is_cell(volume)) {
+        out.push_back(analyze_cell(corner_values(volume), iso, method).subcase);
+        return out;
+    }
+    ExtractStats own;
+    if (stats == nullptr) {
+        ExtractOptions o;
+        o.method = method;
+        o.threads = 1;
+        extract(volume, iso, o, &own);
+        stats = &own;
+    }
+    for (int s = 0; s < kSubcaseCount; ++s) {
+        if (stats->cells_per_subcase[static_cast<std::size_t>(s)] > 0 &&
+            verification::detail::is_ambiguous_subcase(s)) {
+            out.push_back(s);
+        }
+    }
+    return out;
+}
+
+std::string clip(std::string text, std::size_t max_chars = 60)
+{
+    if (text.size() > max_chars) text = text.substr(0, max_chars) + "...";
+    return text;
+}
+
+/// Splits a manifest line at tabs.
+std::vector<std::string_view> split_tabs(std::string_view line)
+{
+    std::vector<std::string_view> fields;
+    std::size_t start = 0;
+    for (;;) {
+        const std::size_t tab = line.find('\t', start);
+        fields.push_back(line.substr(start, tab == std::string_view::npos ? std::string_view::npos
+                                                                          : tab - start));
+        if (tab == std::string_view::npos) break;
+        start = tab + 1;
+    }
+    return fields;
+}
+
+int subcase_index(std::string_view name)
+{
+    for (int s = 0; s < kSubcaseCount; ++s) {
+        if (subcase_name(s) == name) return s;
+    }
+    return -1;
+}
+
+/// Removes the temporary folder of the external command's outputs.
+struct TempFolder {
+    std::filesystem::path path;
+    TempFolder()
+    {
+        const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
+        path = std::filesystem::temp_directory_path() /
+               ("cmc33-verify-" + std::to_string(::getpid()) + "-" + std::to_string(stamp));
+        std::error_code ec;
+        std::filesystem::create_directories(path, ec);
+        if (ec)
+            throw Error(Status::io_error,
+                        path.string() + ": cannot create a temporary folder: " + ec.message());
+    }
+    ~TempFolder()
+    {
+        std::error_code ec;
+        std::filesystem::remove_all(path, ec);
+    }
+    TempFolder(const TempFolder&) = delete;
+    TempFolder& operator=(const TempFolder&) = delete;
+};
+
+std::string last_line(const std::filesystem::path& log)
+{
+    std::ifstream in(log, std::ios::binary);
+    std::string line, last;
+    while (std::getline(in, line)) {
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (line.find_first_not_of(" \t") != std::string::npos) last = line;
+    }
+    return clip(last, 300);
+}
+
+struct CommandResult {
+    std::optional<Mesh> mesh;
+    std::string note; ///< why there is no mesh
+};
+
+CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log)
+{
+    std::error_code ec;
+    std::filesystem::remove(command.output, ec);
+    const std::string line =
+        "(" + command.shell + ") >" + shell_quote(log.string()) + " 2>&1 </dev/null";
+    const int status = std::system(line.c_str());
+    CommandResult result;
+    if (status == -1) {
+        result.note = "could not start the command (std::system returned -1)";
+        return result;
+    }
+    if (WIFSIGNALED(status)) {
+        if (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGQUIT) {
+            throw Error(Status::io_error, "verify: interrupted (the command was killed by signal " +
+                                              std::to_string(WTERMSIG(status)) + ")");
+        }
+        result.note = "the command was killed by signal " + std::to_string(WTERMSIG(status));
+    } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
+        result.note = "the command exited with status " + std::to_string(WEXITSTATUS(status));
+    } else if (!std::filesystem::exists(command.output)) {
+        result.note = "the command wrote no " + command.output.filename().string();
+    } else {
+        try {
+            result.mesh = io::read_mesh(command.output);
+        } catch (const Error& e) {
+            result.note = std::string("its mesh does not read: ") + e.what();
+        }
+    }
+    if (!result.mesh) {
+        const std::string said = last_line(log);
+        if (!said.empty()) result.note += "; it said: " + said;
+    }
+    std::filesystem::remove(command.output, ec);
+    return result;
+}
+
+/// Kind of a manifest entry: cell-* files and lines with a subcase are cells, closed-* files
+/// closed grids, anything else a grid.
+FieldKind kind_of(const ManifestEntry& entry)
+{
+    const std::string stem = std::filesystem::path(entry.file).filename().string();
+    if (stem.rfind("closed", 0) == 0) return FieldKind::closed;
+    if (entry.subcase != "-" || stem.rfind("cell", 0) == 0) return FieldKind::cell;
+    return FieldKind::grid;
+}
+
+struct EntryCheck {
+    const std::filesystem::path& dir;
+    const ManifestEntry& entry;
+    FieldKind kind;
+    std::int64_t order; ///< line index: failures are kept in manifest order
+};
+
+/// Checks one manifest entry with every method (or the command); `scratch` is this thread's
+/// prefix for the command's output and log files.
+void check_entry(const EntryCheck& check, const DatasetVerifyOptions& options,
+                 const std::filesystem::path& scratch, std::vector<Tally>& mine,
+                 std::atomic<std::int64_t>& mismatched)
+{
+    const ManifestEntry& entry = check.entry;
+    const std::filesystem::path path = check.dir / entry.file;
+    const auto volume = std::make_shared<const Volume>(io::read_volume(path));
+    for (Tally& tally : mine) {
+        Outcome outcome;
+        outcome.kind = check.kind;
+        outcome.order = check.order;
+        outcome.name = std::filesystem::path(entry.file).stem().string();
+        outcome.volume = volume;
+        outcome.iso = entry.iso;
+        outcome.expected = &entry.expected;
+        if (tally.report.external) {
+            const ExternalCommand command = expand_command(options.command, path, entry.iso,
+                                                           scratch.string() + "-" + outcome.name);
+            CommandResult result = run_command(command, scratch.string() + "-log.txt");
+            outcome.mesh = std::move(result.mesh);
+            outcome.note = std::move(result.note);
+            outcome.subcases = subcases_of(*volume, entry.iso, Method::cmc33, nullptr);
+        } else {
+            ExtractOptions o;
+            o.method = tally.report.method;
+            o.threads = 1;
+            ExtractStats stats;
+            try {
+                outcome.mesh = extract(*volume, entry.iso, o, &stats);
+            } catch (const Error& e) {
+                outcome.note = std::string("extract failed: ") + e.what();
+            }
+            outcome.subcases = subcases_of(*volume, entry.iso, o.method, &stats);
+        }
+        if (!verification::detail::record(tally, std::move(outcome), options.max_failures)) {
+            mismatched.fetch_add(1, std::memory_order_relaxed);
+        }
+    }
+}
+
+/// Writes field n of `kind` into the dataset and returns its manifest line, or "" if its
+/// topology is undetermined (then nothing is written).
+std::string write_field(const std::filesystem::path& dir, FieldKind kind, std::int64_t n,
+                        std::uint64_t seed, int size)
+{
+    const Volume volume = random_field(kind, n, seed, size);
+    const FieldTopology t = field_topology(volume, 0.0);
+    if (!t.determined) return {};
+    const std::string file =
+        std::string(kFolders[static_cast<std::size_t>(kind)]) + "/" + field_name(kind, n) + ".nrrd";
+    io::write_volume(volume, dir / file);
+    const std::string subcase =
+        kind == FieldKind::cell
+            ? std::string(subcase_name(analyze_cell(corner_values(volume), 0.0).subcase))
+            : "-";
+    return file + "\t0\t" + std::to_string(t.euler) + "\t" + std::to_string(t.b0) + "\t" +
+           std::to_string(t.b1) + "\t" + std::to_string(t.b2) + "\t" +
+           std::to_string(t.boundary_loops) + "\t" + subcase + "\n";
+}
+
+} // namespace
+
+DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options)
+{
+    if (options.cells < 0 || options.grids < 0 || options.closed < 0) {
+        throw Error(Status::invalid_argument, "dataset: field counts must be >= 0; got cells " +
+                                                  std::to_string(options.cells) + ", grids " +
+                                                  std::to_string(options.grids) + ", closed " +
+                                                  std::to_string(options.closed));
+    }
+    const int min_size = options.closed > 0 ? 3 : 2;
+    if (options.size < min_size || options.size > 1024) {
+        throw Error(Status::invalid_argument, "dataset: grid size " + std::to_string(options.size) +
+                                                  " is out of range; expected " +
+                                                  std::to_string(min_size) + " to 1024");
+    }
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec)) {
+        if (!std::filesystem::is_directory(dir, ec)) {
+            throw Error(Status::invalid_argument,
+                        dir.string() +
+                            ": exists and is not a folder; expected a new or empty folder");
+        }
+        if (std::filesystem::directory_iterator(dir, ec) != std::filesystem::directory_iterator()) {
+            throw Error(Status::invalid_argument,
+                        dir.string() + ": folder is not empty; expected a new or empty folder");
+        }
+    }
+    const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids,
+                                                           options.closed};
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        if (counts[k] == 0) continue;
+        const auto folder = dir / kFolders[k];
+        std::filesystem::create_directories(folder, ec);
+        if (ec) {
+            throw Error(Status::io_error,
+                        folder.string() + ": cannot create the folder: " + ec.message());
+        }
+    }
+    const std::int64_t total = options.cells + options.grids + options.closed;
+    const int threads = static_cast<int>(std::clamp<std::int64_t>(
+        detail::resolve_threads(options.threads), 1, std::max<std::int64_t>(total, 1)));
+    verification::detail::Ticker tick(options.progress, total, nullptr);
+
+    DatasetSummary summary;
+    std::string manifest = std::string(kManifestHeader) + "\n";
+    for (std::size_t k = 0; k < counts.size(); ++k) {
+        const auto kind = static_cast<FieldKind>(k);
+        std::vector<std::string> lines(static_cast<std::size_t>(counts[k])); // empty: left out
+        verification::detail::run_parallel(
+            counts[k], threads, 16, tick, [&](int, std::int64_t begin, std::int64_t end) {
+                for (std::int64_t i = begin; i < end; ++i) {
+                    lines[static_cast<std::size_t>(i)] =
+                        write_field(dir, kind, i + 1, options.seed, options.size);
+                }
+            });
+        for (const std::string& line : lines) {
+            if (line.empty()) {
+                ++summary.undetermined[k];
+            } else {
+                ++summary.written[k];
+                manifest += line;
+            }
+        }
+        tick.pass_done(counts[k]);
+    }
+    write_text(dir / "manifest.tsv", manifest);
+    write_text(dir / "README.txt", readme_text(options, summary));
+    summary.seconds = tick.seconds();
+    tick(0);
+    return summary;
+}
+
+std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir)
+{
+    const std::filesystem::path path = dir / "manifest.tsv";
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw Error(Status::io_error, path.string() + ": cannot open the dataset's manifest");
+    std::vector<ManifestEntry> entries;
+    std::string line;
+    int number = 0;
+    auto fail = [&](const std::string& what) {
+        throw Error(Status::bad_format, path.string() + ":" + std::to_string(number) + ": " + what);
+    };
+    while (std::getline(in, line)) {
+        ++number;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        if (number == 1) {
+            if (line != kManifestHeader) {
+                fail("expected the header line \"file iso euler b0 b1 b2 boundary_loops subcase\" "
+                     "(tab-separated) but found \"" +
+                     clip(line) + "\"");
+            }
+            continue;
+        }
+        if (line.empty() || line[0] == '#') continue;
+        const std::vector<std::string_view> f = split_tabs(line);
+        if (f.size() != 8) {
+            fail("expected 8 tab-separated columns (file iso euler b0 b1 b2 boundary_loops "
+                 "subcase) but found " +
+                 std::to_string(f.size()));
+        }
+        ManifestEntry e;
+        e.line = number;
+        e.file = std::string(f[0]);
+        const std::filesystem::path file(e.file);
+        if (e.file.empty() || file.is_absolute() ||
+            std::any_of(file.begin(), file.end(),
+                        [](const std::filesystem::path& p) { return p == ".."; })) {
+            fail(
+                "file \"" + clip(e.file) +
+                "\" is not a path inside the dataset folder; expected e.g. cells/cell-000001.nrrd");
+        }
+        const std::string iso_text(f[1]);
+        const auto iso_end = iso_text.data() + iso_text.size();
+        const auto parsed = std::from_chars(iso_text.data(), iso_end, e.iso);
+        if (parsed.ec != std::errc() || parsed.ptr != iso_end || !std::isfinite(e.iso)) {
+            fail("iso \"" + clip(iso_text) + "\" is not a finite number");
+        }
+        static constexpr std::array<std::string_view, 5> kNames = {"euler", "b0", "b1", "b2",
+                                                                   "boundary_loops"};
+        std::array<std::int64_t, 5> v{};
+        for (std::size_t c = 0; c < 5; ++c) {
+            const std::string_view t = f[c + 2];
+            const auto r = std::from_chars(t.data(), t.data() + t.size(), v[c]);
+            if (r.ec != std::errc() || r.ptr != t.data() + t.size() || (c > 0 && v[c] < 0)) {
+                fail(std::string(kNames[c]) + " \"" + clip(std::string(t)) + "\" is not " +
+                     (c == 0 ? "an integer" : "an integer >= 0"));
+            }
+        }
+        e.expected.determined = true;
+        e.expected.euler = v[0];
+        e.expected.b0 = v[1];
+        e.expected.b1 = v[2];
+        e.expected.b2 = v[3];
+        e.expected.boundary_loops = v[4];
+        if (e.expected.b0 - e.expected.b1 + e.expected.b2 != e.expected.euler) {
+            fail("b0 - b1 + b2 = " + std::to_string(e.expected.b0 - e.expected.b1 + e.expected.b2) +
+                 " differs from euler " + std::to_string(e.expected.euler) +
+                 "; expected them equal");
+        }
+        e.subcase = std::string(f[7]);
+        if (e.subcase != "-" && subcase_index(e.subcase) < 0) {
+            fail("subcase \"" + clip(e.subcase) +
+                 "\" is not a Marching Cubes 33 subcase name (e.g. 13.5.2) or '-'");
+        }
+        entries.push_back(std::move(e));
+    }
+    if (number == 0)
+        throw Error(Status::bad_format,
+                    path.string() + ": is empty; expected a header line and one line per file");
+    return entries;
+}
+
+ExternalCommand expand_command(std::string_view command_template, const std::filesystem::path& in,
+                               double iso, const std::filesystem::path& out_base)
+{
+    const std::string_view kIn = "{in}", kIso = "{iso}", kOut = "{out}";
+    const std::size_t out_at = command_template.find(kOut);
+    for (const std::string_view needed : {kIn, kOut}) {
+        if (command_template.find(needed) == std::string_view::npos) {
+            throw Error(Status::invalid_argument,
+                        "command \"" + clip(std::string(command_template)) + "\" has no " +
+                            std::string(needed) + "; expected placeholders {in}, {iso} and {out}");
+        }
+    }
+    ExternalCommand command;
+    std::string out_text = out_base.string();
+    std::string extension = ".ply";
+    bool extension_given = false;
+    const std::string_view after = command_template.substr(out_at + kOut.size());
+    for (std::string_view ext : {".ply", ".obj", ".off", ".stl"}) {
+        if (after.size() >= ext.size() && after.substr(0, ext.size()) == ext &&
+            (after.size() == ext.size() ||
+             !std::isalnum(static_cast<unsigned char>(after[ext.size()])))) {
+            extension = std::string(ext);
+            extension_given = true;
+        }
+    }
+    command.output = out_text + extension;
+    const std::string out_quoted = shell_quote(extension_given ? out_text : out_text + extension);
+    const std::string in_quoted = shell_quote(in.string());
+    const std::string iso_text = number_text(iso);
+    for (std::size_t i = 0; i < command_template.size();) {
+        const std::string_view rest = command_template.substr(i);
+        if (rest.substr(0, kIn.size()) == kIn) {
+            command.shell += in_quoted;
+            i += kIn.size();
+        } else if (rest.substr(0, kIso.size()) == kIso) {
+            command.shell += iso_text;
+            i += kIso.size();
+        } else if (rest.substr(0, kOut.size()) == kOut) {
+            command.shell += out_quoted;
+            i += kOut.size();
+        } else {
+            command.shell += command_template[i++];
+        }
+    }
+    return command;
+}
+
+VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerifyOptions& options)
+{
+    const std::vector<ManifestEntry> entries = read_manifest(dir);
+    if (entries.empty()) {
+        throw Error(Status::bad_format, (dir / "manifest.tsv").string() +
+                                            ": lists no file; expected one line per file");
+    }
+    const bool external = !options.command.empty();
+    if (external) {
+        (void)expand_command(options.command, "in", 0.0, "out"); // throws without {in} or {out}
+    } else {
+        verification::detail::check_methods(options.methods);
+    }
+    const auto total = static_cast<std::int64_t>(entries.size());
+    const int threads = static_cast<int>(
+        std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, total));
+    std::vector<std::vector<Tally>> tallies =
+        verification::detail::make_tallies(threads, options.methods, external);
+    std::atomic<std::int64_t> mismatched{0};
+    verification::detail::Ticker tick(options.progress, total, &mismatched);
+    std::optional<TempFolder> temp;
+    if (external) temp.emplace();
+
+    // Each kind runs as one pass (in manifest order), so that its rate can be reported.
+    std::array<std::vector<std::size_t>, kFieldKindCount> by_kind;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        by_kind[static_cast<std::size_t>(kind_of(entries[i]))].push_back(i);
+    }
+    VerifyReport report;
+    report.threads = threads;
+    for (int k = 0; k < kFieldKindCount; ++k) {
+        const std::vector<std::size_t>& items = by_kind[static_cast<std::size_t>(k)];
+        const double kind_start = tick.seconds();
+        const auto count = static_cast<std::int64_t>(items.size());
+        verification::detail::run_parallel(
+            count, threads, external ? 2 : 16, tick,
+            [&](int t, std::int64_t begin, std::int64_t end) {
+                for (std::int64_t i = begin; i < end; ++i) {
+                    const std::size_t item = items[static_cast<std::size_t>(i)];
+                    const EntryCheck check{dir, entries[item], static_cast<FieldKind>(k),
+                                           static_cast<std::int64_t>(item)};
+                    const std::filesystem::path scratch =
+                        external ? temp->path / ("t" + std::to_string(t)) : std::filesystem::path();
+                    check_entry(check, options, scratch, tallies[static_cast<std::size_t>(t)],
+                                mismatched);
+                }
+            });
+        report.fields[static_cast<std::size_t>(k)] = count;
+        report.kind_seconds[static_cast<std::size_t>(k)] = tick.seconds() - kind_start;
+        tick.pass_done(count);
+    }
+    std::vector<Tally> merged = verification::detail::merge(tallies, options.max_failures);
+    report.seconds = tick.seconds();
+    verification::detail::finish(merged, options.failures_dir, options.command, report);
+    tick(0);
+    return report;
+}
+
+} // namespace cmc33
