@@ -1,0 +1,239 @@
+// cmc33 info: what a volume holds, and which isovalues are worth trying.
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "cmc33/volume.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+
+namespace cmc33::cli {
+
+namespace {
+
+constexpr int kBins = 16;      // the histogram shown
+constexpr int kFineBins = 4096; // the one quantiles and Otsu's threshold are read from
+
+struct InfoArgs {
+    std::string input;
+    bool json = false;
+    RawVolumeOptions raw;
+};
+
+struct Histogram {
+    double lo = 0, hi = 0;                 ///< value range of the finite samples
+    std::array<std::int64_t, kBins> bins{};
+    std::vector<std::int64_t> fine = std::vector<std::int64_t>(kFineBins, 0);
+    std::vector<double> fine_min = std::vector<double>(kFineBins, 0); ///< smallest sample in each fine bin
+    std::int64_t finite = 0;
+
+    double width() const { return (hi - lo) / kBins; }
+    double fine_width() const { return (hi - lo) / kFineBins; }
+};
+
+template <class T> void fill(const GridView<T>& grid, std::int64_t count, Histogram& h)
+{
+    const double range = h.hi - h.lo;
+    for (std::int64_t i = 0; i < count; ++i) {
+        const double v = static_cast<double>(grid.data[i]);
+        if (!std::isfinite(v)) continue;
+        ++h.finite;
+        const double u = range > 0 ? (v - h.lo) / range : 0.0; // in [0, 1]
+        h.bins[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(u * kBins)))]++;
+        const auto f = static_cast<std::size_t>(std::min(kFineBins - 1, static_cast<int>(u * kFineBins)));
+        if (h.fine[f]++ == 0 || v < h.fine_min[f]) h.fine_min[f] = v;
+    }
+}
+
+/// The q-quantile of the finite samples, read from the fine histogram: the smallest sample of the
+/// bin that holds it. Exact when each bin holds one distinct value (integer data with a range below
+/// 4096), else within a bin width below it.
+double quantile(const Histogram& h, double q)
+{
+    const double target = std::max(1.0, std::ceil(q * static_cast<double>(h.finite)));
+    double seen = 0;
+    for (std::size_t b = 0; b < h.fine.size(); ++b) {
+        seen += static_cast<double>(h.fine[b]);
+        if (seen >= target) return h.fine_min[b];
+    }
+    return h.hi;
+}
+
+/// Otsu's threshold: the value that splits the samples into two classes of largest between-class
+/// variance; for a scan of an object in air it is the object's surface.
+double otsu(const Histogram& h)
+{
+    double total = 0, total_sum = 0;
+    for (int b = 0; b < kFineBins; ++b) {
+        total += static_cast<double>(h.fine[static_cast<std::size_t>(b)]);
+        total_sum += b * static_cast<double>(h.fine[static_cast<std::size_t>(b)]);
+    }
+    double w0 = 0, sum0 = 0, best = -1;
+    int best_b = 0;
+    for (int b = 0; b + 1 < kFineBins; ++b) {
+        w0 += static_cast<double>(h.fine[static_cast<std::size_t>(b)]);
+        sum0 += b * static_cast<double>(h.fine[static_cast<std::size_t>(b)]);
+        const double w1 = total - w0;
+        if (w0 == 0 || w1 == 0) continue;
+        const double m0 = sum0 / w0, m1 = (total_sum - sum0) / w1;
+        const double between = w0 * w1 * (m0 - m1) * (m0 - m1);
+        if (between > best) best = between, best_b = b;
+    }
+    return h.lo + (best_b + 1) * h.fine_width(); // the upper edge of the lower class
+}
+
+/// Centres of the histogram's local maxima, the most populated first.
+std::vector<int> modes(const Histogram& h)
+{
+    std::vector<int> peaks;
+    for (int b = 0; b < kBins; ++b) {
+        const auto n = h.bins[static_cast<std::size_t>(b)];
+        const auto left = b > 0 ? h.bins[static_cast<std::size_t>(b - 1)] : -1;
+        const auto right = b + 1 < kBins ? h.bins[static_cast<std::size_t>(b + 1)] : -1;
+        if (n > 0 && n > left && n >= right) peaks.push_back(b);
+    }
+    std::stable_sort(peaks.begin(), peaks.end(), [&](int a, int b) {
+        return h.bins[static_cast<std::size_t>(a)] > h.bins[static_cast<std::size_t>(b)];
+    });
+    return peaks;
+}
+
+/// A value for display and for --iso: integers for integer samples, 4 significant digits else.
+double round_for(double value, ScalarType type)
+{
+    if (type != ScalarType::f32 && type != ScalarType::f64) return std::round(value);
+    return std::stod(sig(value, 4));
+}
+
+struct Candidate {
+    double value;
+    std::string why;
+};
+
+std::vector<Candidate> candidates(const Histogram& h, ScalarType type)
+{
+    std::vector<Candidate> out;
+    if (h.finite == 0 || !(h.hi > h.lo)) return out;
+    out.push_back({round_for(otsu(h), type), "Otsu's threshold"});
+    std::vector<int> peaks = modes(h);
+    if (peaks.size() > 3) peaks.resize(3);
+    std::sort(peaks.begin(), peaks.end());
+    auto centre = [&](int b) { return h.lo + (b + 0.5) * h.width(); };
+    for (std::size_t i = 0; i + 1 < peaks.size(); ++i) {
+        const double a = centre(peaks[i]), b = centre(peaks[i + 1]);
+        out.push_back({round_for(0.5 * (a + b), type),
+                       "midway between the histogram modes near " + sig(a, 4) + " and " + sig(b, 4)});
+    }
+    return out;
+}
+
+std::string bar(std::int64_t n, std::int64_t largest)
+{
+    constexpr int kWidth = 40;
+    if (n == 0 || largest == 0) return "";
+    // log scale: volumes are mostly background, a linear bar would show only the background bin
+    const double f = std::log1p(static_cast<double>(n)) / std::log1p(static_cast<double>(largest));
+    return std::string(static_cast<std::size_t>(std::max(1.0, std::round(f * kWidth))), '#');
+}
+
+void run_info(const InfoArgs& args)
+{
+    const Volume volume = load_volume(args.input, args.raw);
+    const auto [lo, hi] = value_range(volume);
+    const NonFinite bad = find_non_finite(volume);
+    Histogram h;
+    h.lo = lo, h.hi = hi;
+    volume.visit([&](const auto& grid) { fill(grid, volume.sample_count(), h); });
+    const std::vector<Candidate> cand = candidates(h, volume.type());
+    const std::array<double, 5> qs{0.01, 0.25, 0.5, 0.75, 0.99};
+    const bool has_values = h.finite > 0;
+
+    if (args.json) {
+        Json out = volume_json(args.input, volume);
+        out["samples"] = volume.sample_count();
+        out["min"] = has_values ? json_number(lo) : Json(nullptr);
+        out["max"] = has_values ? json_number(hi) : Json(nullptr);
+        out["non_finite"] = {{"count", bad.count},
+                             {"first", bad.count > 0 ? Json{bad.first[0], bad.first[1], bad.first[2]} : Json(nullptr)}};
+        Json bins = Json::array();
+        for (int b = 0; b < kBins && has_values; ++b) {
+            bins.push_back({{"lo", lo + b * h.width()},
+                            {"hi", b + 1 == kBins ? hi : lo + (b + 1) * h.width()},
+                            {"count", h.bins[static_cast<std::size_t>(b)]}});
+        }
+        out["histogram"] = bins;
+        Json quantiles = Json::object();
+        for (double q : qs) quantiles["p" + num(q * 100)] = has_values ? json_number(quantile(h, q)) : Json(nullptr);
+        out["quantiles"] = quantiles;
+        Json c = Json::array();
+        for (const Candidate& x : cand) c.push_back({{"iso", x.value}, {"why", x.why}});
+        out["candidate_isovalues"] = c;
+        print_json(out);
+        return;
+    }
+    std::cout << args.input << ": " << dims_text(volume.dims()) << " " << type_name(volume.type()) << " ("
+              << volume.sample_count() << " samples, " << volume.byte_size() << " bytes)\n";
+    std::cout << "spacing " << vec_text(volume.spacing()) << ", origin " << vec_text(volume.origin()) << '\n';
+    if (!has_values) {
+        std::cout << "no finite samples\n";
+    } else {
+        std::cout << "values " << num(lo) << " to " << num(hi) << '\n';
+    }
+    if (bad.count > 0) {
+        std::cout << "non-finite samples: " << bad.count << " (NaN or infinite), the first at (" << bad.first[0]
+                  << ", " << bad.first[1] << ", " << bad.first[2] << "); extract refuses this volume\n";
+    }
+    if (!has_values) return;
+    std::cout << "histogram (" << kBins << " bins, bar length on a log scale):\n";
+    const std::int64_t largest = *std::max_element(h.bins.begin(), h.bins.end());
+    for (int b = 0; b < kBins; ++b) {
+        const double a = lo + b * h.width(), z = b + 1 == kBins ? hi : lo + (b + 1) * h.width();
+        char line[160];
+        std::snprintf(line, sizeof line, "  [%11.5g, %11.5g%c %12lld  ", a, z, b + 1 == kBins ? ']' : ')',
+                      static_cast<long long>(h.bins[static_cast<std::size_t>(b)]));
+        std::cout << line << bar(h.bins[static_cast<std::size_t>(b)], largest) << '\n';
+    }
+    std::cout << "quantiles:";
+    for (double q : qs) std::cout << " p" << num(q * 100) << " " << sig(quantile(h, q), 5);
+    std::cout << '\n';
+    if (cand.empty()) {
+        std::cout << "hint: every sample has the same value; there is no isosurface to extract\n";
+        return;
+    }
+    std::cout << "hint: isovalues to try:";
+    for (std::size_t i = 0; i < cand.size(); ++i) {
+        std::cout << (i ? ";" : "") << " --iso " << num(cand[i].value) << " (" << cand[i].why << ")";
+    }
+    std::cout << '\n';
+}
+
+} // namespace
+
+void add_info(CLI::App& app)
+{
+    auto args = std::make_shared<InfoArgs>();
+    CLI::App* cmd = app.add_subcommand("info", "Describe a volume: dimensions, type, value range, histogram");
+    cmd->add_option("INPUT", args->input, "Volume: .nrrd .nhdr .mhd .mha .vtk, or headerless raw with --dims/--type")
+        ->required();
+    cmd->add_flag("--json", args->json, "Print one JSON object");
+    add_raw_volume_options(*cmd, args->raw);
+    cmd->footer(
+        "Reads INPUT and prints its dimensions, sample type, spacing and origin, the range of its\n"
+        "values, how many samples are NaN or infinite (extract refuses those), a 16-bin histogram\n"
+        "and some quantiles, then a hint with isovalues worth trying: Otsu's threshold (the value\n"
+        "that best splits the samples in two classes, e.g. object and air) and the midpoints\n"
+        "between the largest histogram modes. --json prints all of it as one object.\n"
+        "\n"
+        "Examples:\n"
+        "  cmc33 info aneurism.nrrd\n"
+        "  cmc33 info scan.raw --dims 512 512 300 --type int16 --json");
+    cmd->callback([args] { run_info(*args); });
+}
+
+} // namespace cmc33::cli

@@ -1,0 +1,412 @@
+// cmc33 verify: the topology stress test on random fields, or a check of a verification dataset
+// (in-process, or of any extractor run as a command). docs/verification.md explains both.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/verify.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+
+namespace cmc33::cli {
+
+namespace {
+
+/// A progress line is drawn on the terminal without its newline yet.
+bool line_open = false;
+
+/// A run that found mismatches: main() prints the message and exits with status 1.
+class VerificationFailed : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+struct VerifyArgs {
+    std::int64_t cells = 0;
+    std::int64_t grids = 0;
+    std::int64_t closed = 0;
+    int size = 5;
+    std::uint64_t seed = 1;
+    std::vector<std::string> methods;
+    int threads = 0;
+    bool json = false;
+    bool progress = false;
+    std::string failures;
+    int max_failures = 20;
+    std::string dataset;
+    std::string command;
+    std::vector<CLI::Option*> random_only; ///< options that make no sense with --dataset
+};
+
+constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed"};
+
+std::string rate_text(double per_second)
+{
+    return per_second >= 100 ? std::to_string(static_cast<std::int64_t>(per_second + 0.5))
+                             : sig(per_second, 3);
+}
+
+std::vector<Method> parse_methods(const std::vector<std::string>& names)
+{
+    std::vector<Method> methods;
+    for (const std::string& name : names) {
+        const Method m = parse_method(name);
+        if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
+            throw UsageError("--method " + name + " is given twice");
+        }
+        methods.push_back(m);
+    }
+    if (methods.empty()) methods = {Method::cmc33, Method::mc33_lewiner, Method::mc};
+    return methods;
+}
+
+Json report_json(const VerifyReport& r, const VerifyArgs& args)
+{
+    Json fields = Json::object(), rates = Json::object();
+    for (int k = 0; k < kFieldKindCount; ++k) {
+        const std::string kind(field_kind_name(static_cast<FieldKind>(k)));
+        fields[kind] = r.fields[static_cast<std::size_t>(k)];
+        rates[kind] = r.rate(static_cast<FieldKind>(k));
+    }
+    Json out = Json::object();
+    if (args.dataset.empty()) {
+        out["seed"] = r.seed;
+        out["size"] = r.size;
+    } else {
+        out["dataset"] = args.dataset;
+        out["command"] = args.command.empty() ? Json(nullptr) : Json(args.command);
+    }
+    out["fields"] = fields;
+    out["threads"] = r.threads;
+    out["seconds"] = r.seconds;
+    out["fields_per_second"] = rates;
+    Json methods = Json::array();
+    for (const MethodReport& m : r.methods) {
+        Json by_kind = Json::object();
+        for (int k = 0; k < kFieldKindCount; ++k) {
+            by_kind[std::string(field_kind_name(static_cast<FieldKind>(k)))] = {
+                {"checked", m.checked_by_kind[static_cast<std::size_t>(k)]},
+                {"mismatched", m.mismatched_by_kind[static_cast<std::size_t>(k)]}};
+        }
+        Json subcases = Json::object();
+        for (int s = 0; s < kSubcaseCount; ++s) {
+            const auto i = static_cast<std::size_t>(s);
+            if (m.fields_per_subcase[i] == 0) continue;
+            subcases[std::string(subcase_name(s))] = {{"fields", m.fields_per_subcase[i]},
+                                                      {"mismatched", m.mismatches_per_subcase[i]}};
+        }
+        methods.push_back({{"method", m.name},
+                           {"checked", m.checked},
+                           {"matched", m.matched},
+                           {"mismatched", m.mismatched},
+                           {"undetermined", m.undetermined},
+                           {"nonmanifold", m.nonmanifold},
+                           {"unoriented", m.unoriented},
+                           {"errors", m.errors},
+                           {"by_kind", by_kind},
+                           {"subcases", subcases},
+                           {"failures_written", m.failures_written}});
+    }
+    out["methods"] = methods;
+    out["failures"] = r.failures_dir.empty()
+                          ? Json(nullptr)
+                          : Json{{"dir", r.failures_dir.string()},
+                                 {"list", (r.failures_dir / "failures.tsv").string()},
+                                 {"written", r.failures_written}};
+    out["passed"] = r.passed();
+    return out;
+}
+
+std::string pad(std::string text, std::size_t width, bool right = true)
+{
+    if (text.size() >= width) return text;
+    const std::string fill(width - text.size(), ' ');
+    return right ? fill + text : text + fill;
+}
+
+void print_report(const VerifyReport& r, const VerifyArgs& args)
+{
+    std::string head = args.dataset.empty() ? "random fields, seed " + std::to_string(r.seed) + ":"
+                                            : "dataset " + args.dataset + ":";
+    for (int k = 0; k < kFieldKindCount; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        if (r.fields[i] == 0) continue;
+        head += " " + std::to_string(r.fields[i]) + " " + std::string(kKindPlural[i]);
+        if (k != 0 && args.dataset.empty()) head += " " + std::to_string(r.size) + "^3";
+        head += " (" + rate_text(r.rate(static_cast<FieldKind>(k))) + "/s),";
+    }
+    std::cout << head << " " << r.threads << (r.threads == 1 ? " thread, " : " threads, ")
+              << sig(r.seconds, 3) << " s\n";
+    if (!args.command.empty()) std::cout << "command: " << args.command << '\n';
+    std::cout << '\n';
+
+    std::size_t name_width = 12;
+    for (const MethodReport& m : r.methods) name_width = std::max(name_width, m.name.size());
+    std::cout << pad("method", name_width, false) << "  " << pad("checked", 9) << pad("matched", 9)
+              << pad("mismatched", 12) << pad("undetermined", 14) << pad("non-manifold", 14)
+              << "  mismatched cells/grids/closed\n";
+    for (const MethodReport& m : r.methods) {
+        std::cout << pad(m.name, name_width, false) << "  " << pad(std::to_string(m.checked), 9)
+                  << pad(std::to_string(m.matched), 9) << pad(std::to_string(m.mismatched), 12)
+                  << pad(std::to_string(m.undetermined), 14)
+                  << pad(std::to_string(m.nonmanifold), 14) << "  " << m.mismatched_by_kind[0]
+                  << "/" << m.mismatched_by_kind[1] << "/" << m.mismatched_by_kind[2] << '\n';
+    }
+    for (const MethodReport& m : r.methods) {
+        if (m.errors != 0)
+            std::cout << m.name << ": " << m.errors << " fields gave no mesh (see failures.tsv)\n";
+        if (m.unoriented != 0)
+            std::cout << m.name << ": " << m.unoriented << " meshes not consistently oriented\n";
+    }
+
+    std::cout
+        << "\nmismatched / checked fields per subcase (a cell counts for its subcase; a grid for\n"
+           "every face- or interior-tested subcase among its cells)\n"
+        << pad("subcase", 8, false);
+    const std::size_t column = std::max<std::size_t>(name_width, 16) + 2;
+    for (const MethodReport& m : r.methods) std::cout << pad(m.name, column);
+    std::cout << '\n';
+    for (int s = 0; s < kSubcaseCount; ++s) {
+        const auto i = static_cast<std::size_t>(s);
+        const bool any =
+            std::any_of(r.methods.begin(), r.methods.end(),
+                        [&](const MethodReport& m) { return m.fields_per_subcase[i] != 0; });
+        if (!any) continue;
+        std::cout << pad(std::string(subcase_name(s)), 8, false);
+        for (const MethodReport& m : r.methods) {
+            std::cout << pad(m.fields_per_subcase[i] == 0
+                                 ? "-"
+                                 : std::to_string(m.mismatches_per_subcase[i]) + " / " +
+                                       std::to_string(m.fields_per_subcase[i]),
+                             column);
+        }
+        std::cout << '\n';
+    }
+    if (r.failures_written != 0) {
+        std::cout << "\n"
+                  << r.failures_written << " failures written to " << r.failures_dir.string()
+                  << "/ (listed in " << (r.failures_dir / "failures.tsv").string()
+                  << " with the commands that reproduce them)\n";
+    }
+}
+
+void check_usage(const VerifyArgs& args)
+{
+    if (!args.dataset.empty()) {
+        for (const CLI::Option* o : args.random_only) {
+            if (o->count() > 0) {
+                throw UsageError(o->get_name() +
+                                 " is for random fields; --dataset DIR checks the dataset's files");
+            }
+        }
+        if (!args.command.empty()) {
+            try {
+                (void)expand_command(args.command, "in", 0.0, "out");
+            } catch (const Error& e) {
+                throw UsageError(std::string("--cmd: ") + e.what());
+            }
+        }
+        if (!args.command.empty() && !args.methods.empty()) {
+            throw UsageError(
+                "--cmd runs an external extractor; --method chooses cmc33's own: give one of them");
+        }
+        return;
+    }
+    if (!args.command.empty())
+        throw UsageError("--cmd needs --dataset DIR (the files to run it on)");
+    if (args.cells + args.grids + args.closed == 0) {
+        throw UsageError("nothing to do: give --cells N, --grids N and/or --closed N "
+                         "(e.g. --cells 20000 --grids 5000), or --dataset DIR");
+    }
+    const int min_size = args.closed > 0 ? 3 : 2;
+    if (args.size < min_size || args.size > 1024) {
+        throw UsageError("--size " + std::to_string(args.size) + " is out of range; expected " +
+                         std::to_string(min_size) + " to 1024" +
+                         (args.closed > 0 ? " (closed grids need an interior sample)" : ""));
+    }
+}
+
+void run_verify(const VerifyArgs& args, const std::string& failures_default)
+{
+    check_usage(args);
+    const std::filesystem::path failures = args.failures.empty() ? failures_default : args.failures;
+    VerifyReport report;
+    if (args.dataset.empty()) {
+        VerifyOptions options;
+        options.methods = parse_methods(args.methods);
+        options.cells = args.cells;
+        options.grids = args.grids;
+        options.closed = args.closed;
+        options.size = args.size;
+        options.seed = args.seed;
+        options.threads = args.threads;
+        options.failures_dir = failures;
+        options.max_failures = args.max_failures;
+        options.progress = progress_line(args.progress, "fields");
+        try {
+            report = verify(options);
+        } catch (...) {
+            end_progress_line();
+            throw;
+        }
+    } else {
+        DatasetVerifyOptions options;
+        if (args.command.empty()) options.methods = parse_methods(args.methods);
+        options.command = args.command;
+        options.threads = args.threads;
+        options.failures_dir = failures;
+        options.max_failures = args.max_failures;
+        options.progress = progress_line(args.progress, "files");
+        try {
+            report = verify_dataset(args.dataset, options);
+        } catch (...) {
+            end_progress_line();
+            throw;
+        }
+    }
+    if (args.json) {
+        print_json(report_json(report, args));
+    } else {
+        print_report(report, args);
+    }
+    if (!report.passed()) {
+        std::string what;
+        for (const MethodReport& m : report.methods) {
+            if (m.mismatched == 0) continue;
+            what += (what.empty() ? "" : ", ") + m.name + " " + std::to_string(m.mismatched) +
+                    " mismatched";
+            if (m.nonmanifold != 0) what += " (" + std::to_string(m.nonmanifold) + " non-manifold)";
+        }
+        if (!report.failures_dir.empty())
+            what += "; failures in " + report.failures_dir.string() + "/";
+        throw VerificationFailed("verify: " + what);
+    }
+}
+
+} // namespace
+
+/// The progress line on stderr: rewritten in place about once a second when stderr is a
+/// terminal (or printed as lines when `forced` and it is not), and always a final line.
+ProgressCallback progress_line(bool forced, const std::string& what)
+{
+    line_open = false;
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    struct State {
+        double last = -1;
+        bool finished = false;
+    };
+    auto state = std::make_shared<State>();
+    return [tty, forced, what, state](const VerifyProgress& p) {
+        if (state->finished) return;
+        const bool final = p.done == p.total;
+        if (!final && (!(tty || forced) || p.seconds - state->last < 1.0)) return;
+        state->last = p.seconds;
+        state->finished = final;
+        const double rate = p.seconds > 0 ? static_cast<double>(p.done) / p.seconds : 0.0;
+        std::string line = std::to_string(p.done) + "/" + std::to_string(p.total) + " " + what +
+                           ", " + rate_text(rate) + "/s, " + sig(p.seconds, 3) + " s";
+        if (p.mismatched != 0) line += ", " + std::to_string(p.mismatched) + " mismatched";
+        std::cout.flush();
+        if (tty) {
+            std::cerr << '\r' << line << "\x1b[K" << (final ? "\n" : "") << std::flush;
+            line_open = !final;
+        } else {
+            std::cerr << line << '\n' << std::flush;
+        }
+    };
+}
+
+/// Ends a half-drawn progress line, so that an error message that follows starts its own line.
+void end_progress_line()
+{
+    if (line_open) std::cerr << '\n';
+    line_open = false;
+}
+
+void add_verify(CLI::App& app)
+{
+    auto args = std::make_shared<VerifyArgs>();
+    CLI::App* cmd = app.add_subcommand(
+        "verify",
+        "Topology stress test: mesh invariants against the field's, on random fields or a dataset");
+    const std::string random_group = "Random fields";
+    args->random_only.push_back(
+        cmd->add_option("--cells", args->cells, "Random single cells (2x2x2 samples)")
+            ->type_name("N")
+            ->check(CLI::NonNegativeNumber)
+            ->group(random_group));
+    args->random_only.push_back(
+        cmd->add_option("--grids", args->grids, "Random grids, samples uniform in [-1, 1]")
+            ->type_name("N")
+            ->check(CLI::NonNegativeNumber)
+            ->group(random_group));
+    args->random_only.push_back(
+        cmd->add_option("--closed", args->closed, "Random grids whose surfaces are all closed")
+            ->type_name("N")
+            ->check(CLI::NonNegativeNumber)
+            ->group(random_group));
+    args->random_only.push_back(
+        cmd->add_option("--size", args->size, "Samples per axis of the grids (default 5)")
+            ->type_name("N")
+            ->group(random_group));
+    args->random_only.push_back(
+        cmd->add_option("--seed", args->seed, "Seed of the random fields (default 1)")
+            ->type_name("S")
+            ->group(random_group));
+    cmd->add_option("--dataset", args->dataset,
+                    "Check the files of a dataset written by `cmc33 dataset`")
+        ->type_name("DIR")
+        ->group("Dataset");
+    cmd->add_option("--cmd", args->command,
+                    "With --dataset: judge this extractor command instead, e.g.\n"
+                    "'tool {in} {iso} {out}' ({out}: a .ply to write)")
+        ->type_name("TEMPLATE")
+        ->group("Dataset");
+    cmd->add_option("--method", args->methods,
+                    "Method to check; repeat for several (default: all three)")
+        ->type_name("NAME")
+        ->check(method_validator());
+    cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0)")
+        ->type_name("N")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--failures", args->failures,
+                    "Folder for failing fields and meshes (default ./cmc33-failures,\n"
+                    "created only if something fails)")
+        ->type_name("DIR");
+    cmd->add_option("--max-failures", args->max_failures,
+                    "Failing fields saved per method (default 20)")
+        ->type_name("N")
+        ->check(CLI::NonNegativeNumber);
+    cmd->add_flag("--json", args->json, "Print one JSON object instead of the tables");
+    cmd->add_flag("--progress", args->progress,
+                  "Progress lines on stderr even when it is not a terminal");
+    cmd->footer(
+        "For every field, the Euler characteristic, Betti numbers b0 b1 b2 and boundary loops of "
+        "the\n"
+        "level set f = 0 of its trilinear interpolant are computed from the samples alone and\n"
+        "compared with those of the mesh each method extracts; a mesh matches if they are equal "
+        "and\n"
+        "it has no non-manifold edge or vertex. Fields whose topology cannot be settled are "
+        "counted\n"
+        "as undetermined. Failing fields are saved with the commands that reproduce them.\n"
+        "Exit status: 0 all matched, 1 a mismatch or non-manifold mesh, 2 bad usage.\n"
+        "\n"
+        "Examples:\n"
+        "  cmc33 verify --method cmc33 --cells 20000 --grids 5000 --closed 1000\n"
+        "  cmc33 verify --dataset mc-data --cmd 'mytool {in} {iso} {out}'");
+    cmd->callback([args] { run_verify(*args, "cmc33-failures"); });
+}
+
+} // namespace cmc33::cli

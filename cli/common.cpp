@@ -1,0 +1,282 @@
+#include "common.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <optional>
+#include <string>
+
+#include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
+
+namespace cmc33::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// "N" must be a whole number >= 1 (CLI11's PositiveNumber prints DBL_MAX in its message).
+const CLI::Validator kPositiveInteger(
+    [](std::string& text) -> std::string {
+        std::int64_t n = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+        if (ec != std::errc() || end != text.data() + text.size() || n < 1) {
+            return "expected a whole number >= 1, got '" + text + "'";
+        }
+        return {};
+    },
+    "N >= 1", "positive integer");
+
+const CLI::Validator kPositiveReal(
+    [](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || *end != '\0' || !std::isfinite(v) || v <= 0) {
+            return "expected a finite number > 0, got '" + text + "'";
+        }
+        return {};
+    },
+    "> 0", "positive number");
+
+} // namespace
+
+bool RawVolumeOptions::any_given() const
+{
+    return std::any_of(given.begin(), given.end(), [](const CLI::Option* o) { return o->count() > 0; });
+}
+
+void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw)
+{
+    const std::string group = "Headerless raw volumes (any extension but .nrrd .nhdr .mhd .mha .vtk)";
+    raw.given.push_back(command.add_option("--dims", raw.dims, "Samples along x, y, z")
+                            ->expected(3)
+                            ->type_name("X Y Z")
+                            ->check(kPositiveInteger)
+                            ->group(group));
+    raw.given.push_back(
+        command.add_option("--type", raw.type, "Sample type: int8 uint8 int16 uint16 int32 uint32 float double")
+            ->type_name("T")
+            ->check(CLI::Validator(
+                [](std::string& name) -> std::string {
+                    try {
+                        (void)io::parse_type(name);
+                        return {};
+                    } catch (const Error& e) {
+                        return e.what();
+                    }
+                },
+                "TYPE", "type"))
+            ->group(group));
+    raw.given.push_back(command.add_option("--spacing", raw.spacing, "Distance between samples along x, y, z (default 1 1 1)")
+                            ->expected(3)
+                            ->type_name("SX SY SZ")
+                            ->check(kPositiveReal)
+                            ->group(group));
+    raw.given.push_back(command.add_option("--endian", raw.endian, "Byte order of the samples (default little)")
+                            ->type_name("ORDER")
+                            ->check(CLI::IsMember({"little", "big"}))
+                            ->group(group));
+    raw.given.push_back(command.add_option("--header-bytes", raw.header_bytes, "Bytes to skip at the start of the file (default 0)")
+                            ->type_name("N")
+                            ->group(group));
+}
+
+Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
+{
+    if (io::has_volume_header(path)) {
+        if (raw.any_given()) {
+            throw UsageError("--dims/--type are for headerless raw files; " + path +
+                             " has a header that gives its dimensions and type");
+        }
+        return io::read_volume(path);
+    }
+    const bool has_dims = !raw.dims.empty(), has_type = !raw.type.empty();
+    if (!has_dims || !has_type) {
+        std::error_code ec;
+        if (!fs::exists(path, ec)) throw Error(Status::io_error, path + ": cannot open: no such file");
+        if (fs::is_directory(path, ec)) {
+            throw Error(Status::io_error, path + ": is a directory, expected a volume file");
+        }
+        if (has_dims || has_type) {
+            throw UsageError(std::string(has_dims ? "--dims needs --type" : "--type needs --dims") +
+                             " to read the headerless file " + path);
+        }
+        throw UsageError(path + ": no volume header known by its extension (.nrrd .nhdr .mhd .mha "
+                                ".vtk); for a headerless raw file give --dims X Y Z and --type T");
+    }
+    io::RawOptions options;
+    options.dims = {raw.dims[0], raw.dims[1], raw.dims[2]};
+    options.type = io::parse_type(raw.type);
+    if (!raw.spacing.empty()) options.spacing = {raw.spacing[0], raw.spacing[1], raw.spacing[2]};
+    options.endian = raw.endian == "big" ? io::Endian::big : io::Endian::little;
+    options.header_bytes = raw.header_bytes;
+    return io::read_volume(path, options);
+}
+
+CLI::Validator method_validator()
+{
+    return CLI::Validator(
+        [](std::string& name) -> std::string {
+            try {
+                (void)parse_method(name);
+                return {};
+            } catch (const Error& e) {
+                return e.what();
+            }
+        },
+        "cmc33|mc33-lewiner|mc", "method");
+}
+
+namespace {
+
+template <class T> std::string shortest(T value)
+{
+    if (std::isnan(value)) return "nan";
+    if (std::isinf(value)) return value > 0 ? "inf" : "-inf";
+    char text[64];
+    const auto result = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, result.ptr);
+}
+
+} // namespace
+
+std::string num(double value) { return shortest(value); }
+std::string num(float value) { return shortest(value); }
+
+double pretty(float value)
+{
+    if (!std::isfinite(value)) return static_cast<double>(value);
+    const std::string text = shortest(value);
+    return std::strtod(text.c_str(), nullptr);
+}
+
+std::string sig(double value, int digits)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*g", digits, value);
+    return text;
+}
+
+std::string dims_text(const Index3& dims)
+{
+    return std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" + std::to_string(dims[2]);
+}
+
+std::string vec_text(const Vec3& v)
+{
+    return "(" + num(v[0]) + ", " + num(v[1]) + ", " + num(v[2]) + ")";
+}
+
+Json json_number(double value)
+{
+    if (!std::isfinite(value)) return nullptr;
+    return value;
+}
+
+Json volume_json(const std::string& path, const Volume& volume)
+{
+    const Index3& d = volume.dims();
+    const Vec3& s = volume.spacing();
+    const Vec3& o = volume.origin();
+    return Json{{"file", path},
+                {"dims", {d[0], d[1], d[2]}},
+                {"type", std::string(type_name(volume.type()))},
+                {"spacing", {json_number(s[0]), json_number(s[1]), json_number(s[2])}},
+                {"origin", {json_number(o[0]), json_number(o[1]), json_number(o[2])}}};
+}
+
+Json topology_json(const MeshTopology& t)
+{
+    return Json{{"euler", t.euler},
+                {"betti", {t.components, t.b1, t.closed_components}},
+                {"components", t.components},
+                {"closed_components", t.closed_components},
+                {"boundary_edges", t.boundary_edges},
+                {"boundary_loops", t.boundary_loops},
+                {"nonmanifold_edges", t.nonmanifold_edges},
+                {"nonmanifold_vertices", t.nonmanifold_vertices},
+                {"degenerate_triangles", t.degenerate_triangles},
+                {"closed", t.closed},
+                {"oriented", t.oriented}};
+}
+
+namespace {
+
+bool is_flat(const Json& json)
+{
+    return std::none_of(json.begin(), json.end(), [](const Json& e) { return e.is_structured(); });
+}
+
+/// Like dump(2), but an array of numbers, strings or booleans stays on one line: "dims": [8, 8, 8].
+void write_json(std::ostream& out, const Json& json, int indent)
+{
+    const std::string pad(static_cast<std::size_t>(indent + 2), ' '), end_pad(static_cast<std::size_t>(indent), ' ');
+    if (json.is_array() && (json.empty() || is_flat(json))) {
+        out << '[';
+        for (std::size_t i = 0; i < json.size(); ++i) out << (i ? ", " : "") << json[i].dump();
+        out << ']';
+    } else if (json.is_array()) {
+        out << "[\n";
+        for (std::size_t i = 0; i < json.size(); ++i) {
+            out << pad;
+            write_json(out, json[i], indent + 2);
+            out << (i + 1 < json.size() ? ",\n" : "\n");
+        }
+        out << end_pad << ']';
+    } else if (json.is_object() && !json.empty()) {
+        out << "{\n";
+        std::size_t i = 0;
+        for (auto it = json.begin(); it != json.end(); ++it, ++i) {
+            out << pad << Json(it.key()).dump() << ": ";
+            write_json(out, it.value(), indent + 2);
+            out << (i + 1 < json.size() ? ",\n" : "\n");
+        }
+        out << end_pad << '}';
+    } else {
+        out << json.dump();
+    }
+}
+
+} // namespace
+
+void print_json(const Json& json)
+{
+    write_json(std::cout, json, 0);
+    std::cout << '\n';
+}
+
+void check_mesh_output(const std::string& output, bool ascii)
+{
+    if (output.empty()) {
+        if (ascii) throw UsageError("--ascii needs -o OUT.ply");
+        return;
+    }
+    const fs::path path(output);
+    std::string ext = path.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (ext != ".ply" && ext != ".obj" && ext != ".stl" && ext != ".off") {
+        // write_mesh checks the extension before it creates anything: let it say what it accepts.
+        io::write_mesh(Mesh{}, path);
+        throw Error(Status::unsupported_format, output + ": unsupported mesh extension; expected .ply, .obj, .stl or .off");
+    }
+    if (ascii && ext != ".ply") throw UsageError("--ascii is for .ply output only, not " + output);
+    const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw Error(Status::io_error, output + ": cannot write: it is a directory");
+    if (!fs::is_directory(dir, ec)) {
+        throw Error(Status::io_error, output + ": cannot write: the directory " + dir.string() + " does not exist");
+    }
+}
+
+void rethrow_naming(const Error& error, const std::string& path)
+{
+    const std::string message = error.what();
+    if (message.find(path) != std::string::npos) throw error;
+    throw Error(error.status(), path + ": " + message);
+}
+
+} // namespace cmc33::cli

@@ -1,0 +1,89 @@
+#pragma once
+// What the commands share: usage errors, the raw-volume options, number formatting, JSON helpers.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/mesh.hpp"
+#include "cmc33/topology.hpp"
+#include "cmc33/verify.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33::cli {
+
+/// JSON objects keep their keys in insertion order, so output reads in a fixed, logical order.
+using Json = nlohmann::ordered_json;
+
+/// A usage mistake found after CLI11 parsed the line (exit 2, like CLI11's own parse errors).
+class UsageError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+/// --dims, --type, --spacing, --endian, --header-bytes: what a headerless raw file cannot say.
+struct RawVolumeOptions {
+    std::vector<std::int64_t> dims;
+    std::string type;
+    std::vector<double> spacing;
+    std::string endian = "little";
+    std::uint64_t header_bytes = 0;
+    std::vector<CLI::Option*> given; ///< the options, to tell whether any was on the line
+
+    bool any_given() const;
+};
+
+/// Adds the raw-volume options to `command`, in their own help group.
+void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw);
+
+/// Reads a volume. Files with a known header take no raw options (UsageError if some are given);
+/// other files need --dims and --type (UsageError if missing). @throws Error from the readers.
+Volume load_volume(const std::string& path, const RawVolumeOptions& raw);
+
+/// A CLI11 validator accepting the names cmc33::parse_method accepts.
+CLI::Validator method_validator();
+
+/// Shortest decimal text that reads back as the same double: "80", "0.1", "1e-07", "nan".
+std::string num(double value);
+/// Same, for a float: 0.3f prints "0.3" (not the double expansion of the float).
+std::string num(float value);
+/// The double nearest to the shortest decimal text of `value`: 0.3f -> 0.3, for JSON output.
+double pretty(float value);
+/// printf("%.*g"): `digits` significant digits.
+std::string sig(double value, int digits);
+/// "256x256x256".
+std::string dims_text(const Index3& dims);
+/// "(1, 0.5, 2)".
+std::string vec_text(const Vec3& v);
+
+/// A JSON number, or null for NaN and infinities (JSON has no such numbers).
+Json json_number(double value);
+/// {"file", "dims", "type", "spacing", "origin"}.
+Json volume_json(const std::string& path, const Volume& volume);
+/// {"euler", "betti", "components", "closed_components", "boundary_edges", "boundary_loops",
+///  "nonmanifold_edges", "nonmanifold_vertices", "degenerate_triangles", "closed", "oriented"}.
+Json topology_json(const MeshTopology& topology);
+
+/// Writes one JSON object to stdout, indented, with a final newline.
+void print_json(const Json& json);
+
+/// If `output` is not empty: throws, before any work is done, what write_mesh would throw for
+/// it (unknown extension: the library's Error; a missing directory: Error{io_error}) and a
+/// UsageError for --ascii with anything but .ply.
+void check_mesh_output(const std::string& output, bool ascii);
+
+/// The progress of verify and dataset on stderr (cmd_verify.cpp): redrawn in place on a terminal,
+/// about once a second; when stderr is not a terminal, lines only if `forced`; always a final line.
+ProgressCallback progress_line(bool forced, const std::string& what);
+/// Ends a half-drawn progress line, so that an error message that follows starts its own line.
+void end_progress_line();
+
+/// Throws `error` again with "path: " in front of its message, unless the message names the path.
+[[noreturn]] void rethrow_naming(const Error& error, const std::string& path);
+
+} // namespace cmc33::cli

@@ -1,0 +1,116 @@
+// cmc33: the command-line tool. Parses the line with CLI11, runs the one command given, and maps
+// every failure to one line on stderr and an exit code:
+//   0 success; 1 bad input or failure (cmc33::Error, unreadable file, non-finite sample, ...);
+//   2 bad usage (CLI11's parse errors and the commands' UsageError).
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "cmc33/error.hpp"
+#include "cmc33/version.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+
+namespace {
+
+constexpr int kExitFailure = 1;
+constexpr int kExitUsage = 2;
+
+/// One line: messages from files may hold newlines (a quoted header line), the contract is one line.
+std::string one_line(std::string message)
+{
+    for (char& c : message) {
+        if (c == '\n' || c == '\r') c = ' ';
+    }
+    return message;
+}
+
+int fail(const std::string& message)
+{
+    std::cout.flush();
+    std::cerr << "cmc33: " << one_line(message) << '\n';
+    return kExitFailure;
+}
+
+int usage(const std::string& message)
+{
+    std::cout.flush();
+    std::cerr << "cmc33: " << one_line(message) << '\n' << "Run with --help for more information.\n";
+    return kExitUsage;
+}
+
+/// CLI11 reads "-5" as a value (no option is named -5) but "-.5" as the short option '.'; spell
+/// such numbers "-0.5" so that `cmc33 cell -.5 ...` means what it says.
+std::vector<std::string> arguments(int argc, char** argv)
+{
+    std::vector<std::string> args;
+    for (int i = argc - 1; i >= 1; --i) { // CLI11 takes them in reverse order
+        std::string a = argv[i];
+        if (a.size() >= 3 && a[0] == '-' && a[1] == '.' && a[2] >= '0' && a[2] <= '9') a.insert(1, "0");
+        args.push_back(std::move(a));
+    }
+    return args;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app("cmc33 " CMC33_VERSION_STRING ": extracts a topologically correct, manifold isosurface mesh\n"
+                 "from a 3D scalar volume with Marching Cubes 33 (Custodio et al. 2013), and inspects\n"
+                 "volumes, meshes and single cells.",
+                 "cmc33");
+    app.set_version_flag("--version", "cmc33 " CMC33_VERSION_STRING, "Print the version and exit");
+    app.require_subcommand(1);
+    app.allow_extras(false);
+    app.footer("Run `cmc33 COMMAND --help` for a command's options and an example.\n"
+               "Exit codes: 0 success, 1 bad input or failure, 2 bad usage.\n"
+               "Example:\n"
+               "  cmc33 extract head.nrrd --iso 80 -o head.ply");
+    app.get_formatter()->column_width(36);
+    for (const cmc33::cli::AddCommand add : cmc33::cli::kCommands) add(app);
+
+    try {
+        std::vector<std::string> args = arguments(argc, argv);
+        if (!args.empty() && !args.back().empty() && args.back()[0] != '-') {
+            // CLI11 would only say "A subcommand is required".
+            std::string known;
+            bool found = false;
+            for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+                known += (known.empty() ? "" : ", ") + sub->get_name();
+                found = found || sub->get_name() == args.back();
+            }
+            if (!found) return usage("unknown command '" + args.back() + "'; the commands are " + known);
+        }
+        try {
+            app.parse(args);
+        } catch (const CLI::CallForHelp& e) {
+            return app.exit(e);
+        } catch (const CLI::CallForAllHelp& e) {
+            return app.exit(e);
+        } catch (const CLI::CallForVersion& e) {
+            return app.exit(e);
+        } catch (const CLI::ParseError& e) {
+            return usage(e.what());
+        }
+        std::cout.flush();
+        if (!std::cout) return fail("cannot write to standard output");
+        return 0;
+    } catch (const cmc33::cli::UsageError& e) {
+        return usage(e.what());
+    } catch (const cmc33::Error& e) {
+        return fail(e.what());
+    } catch (const std::bad_alloc&) {
+        return fail("out of memory");
+    } catch (const std::exception& e) {
+        return fail(e.what());
+    } catch (...) {
+        return fail("unknown error");
+    }
+}

@@ -1,0 +1,480 @@
+// Runs the real `cmc33` executable (CMC33_EXE) and checks its output, files and exit codes.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/version.hpp"
+#include "cmc33/volume.hpp"
+#include "test_support.hpp"
+
+namespace cmc33 {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+struct Result {
+    int code = -1;
+    std::string out;
+    std::string err;
+};
+
+std::string quote(const std::string& s)
+{
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+/// Runs `cmc33 ARGS` through the shell: stdout through a pipe, stderr through a file.
+Result run(const std::string& args)
+{
+    static int counter = 0;
+    const fs::path err_file = fs::temp_directory_path() /
+                              ("cmc33-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".err");
+    const std::string command = quote(CMC33_EXE) + " " + args + " 2>" + quote(err_file.string()) + " </dev/null";
+    Result r;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) {
+        ADD_FAILURE() << "popen failed for " << command;
+        return r;
+    }
+    char buffer[4096];
+    std::size_t n;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
+    const int status = ::pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = test::read_file(err_file);
+    fs::remove(err_file);
+    return r;
+}
+
+/// Parses stdout as one JSON value; a failure is reported with the text.
+json parse(const Result& r)
+{
+    try {
+        return json::parse(r.out);
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "stdout is not JSON (" << e.what() << "):\n" << r.out;
+        return json::object();
+    }
+}
+
+/// The error contract: exit 1, one line "cmc33: ..." on stderr naming `name`, nothing on stdout.
+void expect_failure(const Result& r, const std::string& name)
+{
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_NE(r.err.find(name), std::string::npos) << "stderr does not name " << name << ": " << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
+void expect_usage_error(const Result& r)
+{
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("--help"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
+// The sphere |x - c| = 6.2 as the level set f = -3.8 of f = |x - c| - 10: a negative isovalue, on a
+// 20^3 grid, centre off the samples so that no sample equals the isovalue.
+constexpr const char* kIso = "-3.8";
+
+double sphere_field(std::int64_t i, std::int64_t j, std::int64_t k)
+{
+    const double x = static_cast<double>(i) - 9.5, y = static_cast<double>(j) - 9.3, z = static_cast<double>(k) - 9.1;
+    return std::sqrt(x * x + y * y + z * z) - 10;
+}
+
+Volume sphere_volume() { return test::make_volume({20, 20, 20}, sphere_field); }
+
+fs::path write_sphere(const fs::path& dir, const std::string& name = "sphere.nrrd")
+{
+    const fs::path path = dir / name;
+    io::write_volume(sphere_volume(), path);
+    return path;
+}
+
+std::vector<std::string> files_in(const fs::path& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+// ---- conventions ------------------------------------------------------------------------------
+
+TEST(Cli, VersionAndHelp)
+{
+    const Result v = run("--version");
+    EXPECT_EQ(v.code, 0);
+    EXPECT_EQ(v.out, "cmc33 " CMC33_VERSION_STRING "\n");
+
+    const Result h = run("--help");
+    EXPECT_EQ(h.code, 0);
+    for (const char* command : {"extract", "info", "topo", "cell"}) {
+        EXPECT_NE(h.out.find(command), std::string::npos) << command;
+        const Result c = run(std::string(command) + " --help");
+        EXPECT_EQ(c.code, 0) << command;
+        EXPECT_NE(c.out.find("Example"), std::string::npos) << command << ":\n" << c.out;
+        EXPECT_NE(c.out.find("cmc33 " + std::string(command) + " "), std::string::npos) << command;
+    }
+}
+
+TEST(Cli, UsageErrorsExitTwo)
+{
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    expect_usage_error(run(""));
+    expect_usage_error(run("frobnicate"));
+    expect_usage_error(run("--frobnicate"));
+    expect_usage_error(run("extract " + sphere + " --iso 1 --frobnicate"));
+    expect_usage_error(run("extract " + sphere));                        // --iso missing
+    expect_usage_error(run("extract --iso 1"));                          // INPUT missing
+    expect_usage_error(run("extract " + sphere + " --iso"));             // value missing
+    expect_usage_error(run("extract " + sphere + " --iso abc"));         // not a number
+    expect_usage_error(run("extract " + sphere + " --iso 1 --method marching"));
+    expect_usage_error(run("extract " + sphere + " --iso 1 --threads -1"));
+    expect_usage_error(run("extract " + sphere + " --iso 1 --repeat 0"));
+    expect_usage_error(run("extract " + sphere + " --iso 1 --dims 20 20 20 --type double"));
+    expect_usage_error(run("extract " + sphere + " --iso 1 -o " + quote((dir / "m.obj").string()) + " --ascii"));
+    expect_usage_error(run("cell 1 2 3 4 5 6 7"));
+    expect_usage_error(run("cell 1 2 3 4 5 6 7 8 9"));
+    expect_usage_error(run("cell 1 2 3 4 5 6 7 x"));
+    expect_usage_error(run("cell 1 2 3 4 5 6 7 8 --method marching"));
+    expect_usage_error(run("topo"));
+    EXPECT_FALSE(fs::exists(dir / "m.obj"));
+}
+
+// ---- extract ----------------------------------------------------------------------------------
+
+TEST(Cli, ExtractEveryMeshFormatAndTopoAgrees)
+{
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    for (const std::string name : {"m.ply", "m.obj", "m.stl", "m.off", "ascii.ply"}) {
+        SCOPED_TRACE(name);
+        const fs::path out = dir / name;
+        const Result e = run("extract " + sphere + " -i " + kIso + " -o " + quote(out.string()) + " --json" +
+                             (name == "ascii.ply" ? " --ascii" : ""));
+        ASSERT_EQ(e.code, 0) << e.err;
+        EXPECT_EQ(e.err, "");
+        ASSERT_TRUE(fs::exists(out));
+        const json ej = parse(e);
+        EXPECT_EQ(ej["output"], out.string());
+
+        const Result t = run("topo " + quote(out.string()) + " --json");
+        ASSERT_EQ(t.code, 0) << t.err;
+        const json tj = parse(t);
+        EXPECT_EQ(tj["vertices"], ej["vertices"]);
+        EXPECT_EQ(tj["faces"], ej["triangles"]);
+        EXPECT_EQ(tj["euler"], 2);
+        EXPECT_EQ(tj["betti"], json({1, 0, 1}));
+        EXPECT_EQ(tj["edges"].get<std::int64_t>(), ej["vertices"].get<std::int64_t>() + ej["triangles"].get<std::int64_t>() - 2);
+        for (const char* key : {"euler", "betti", "components", "boundary_edges", "boundary_loops", "nonmanifold_edges",
+                                "nonmanifold_vertices", "closed", "oriented"}) {
+            EXPECT_EQ(tj[key], ej["topology"][key]) << key;
+        }
+
+        const Result text = run("topo " + quote(out.string()));
+        ASSERT_EQ(text.code, 0) << text.err;
+        EXPECT_NE(text.out.find(std::to_string(ej["vertices"].get<int>()) + " vertices"), std::string::npos) << text.out;
+        EXPECT_NE(text.out.find("euler 2"), std::string::npos) << text.out;
+    }
+    EXPECT_NE(test::read_file(dir / "ascii.ply").find("format ascii"), std::string::npos);
+}
+
+TEST(Cli, ExtractJsonHasEveryKey)
+{
+    const fs::path dir = test::temp_dir();
+    const fs::path sphere = write_sphere(dir);
+    const Result r = run("extract " + quote(sphere.string()) + " --iso " + kIso + " --json --threads 2");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    ASSERT_TRUE(j.is_object());
+    EXPECT_EQ(j["input"]["file"], sphere.string());
+    EXPECT_EQ(j["input"]["dims"], json({20, 20, 20}));
+    EXPECT_EQ(j["input"]["type"], "double");
+    EXPECT_EQ(j["input"]["spacing"], json({1, 1, 1}));
+    EXPECT_EQ(j["input"]["origin"], json({0, 0, 0}));
+    EXPECT_DOUBLE_EQ(j["iso"].get<double>(), -3.8);
+    EXPECT_EQ(j["method"], "cmc33");
+    EXPECT_GT(j["vertices"].get<int>(), 100);
+    EXPECT_GT(j["triangles"].get<int>(), 200);
+    // a closed triangulated sphere: F = 2V - 4
+    EXPECT_EQ(j["triangles"].get<int>(), 2 * j["vertices"].get<int>() - 4);
+    EXPECT_GE(j["seconds"].get<double>(), 0.0);
+    ASSERT_EQ(j["runs_seconds"].size(), 1u);
+    EXPECT_EQ(j["runs_seconds"][0], j["seconds"]);
+    EXPECT_EQ(j["threads"], 2);
+    EXPECT_TRUE(j["output"].is_null());
+    const json& t = j["topology"];
+    EXPECT_EQ(t["euler"], 2);
+    EXPECT_EQ(t["betti"], json({1, 0, 1}));
+    EXPECT_EQ(t["components"], 1);
+    EXPECT_EQ(t["boundary_edges"], 0);
+    EXPECT_EQ(t["boundary_loops"], 0);
+    EXPECT_EQ(t["nonmanifold_edges"], 0);
+    EXPECT_EQ(t["nonmanifold_vertices"], 0);
+    EXPECT_EQ(t["closed"], true);
+    EXPECT_EQ(t["oriented"], true);
+    const json& s = j["subcases"];
+    ASSERT_TRUE(s.is_object());
+    EXPECT_EQ(s.size(), static_cast<std::size_t>(kSubcaseCount));
+    std::int64_t cells = 0;
+    for (int i = 0; i < kSubcaseCount; ++i) {
+        const std::string name(subcase_name(i));
+        ASSERT_TRUE(s.contains(name)) << name;
+        cells += s[name].get<std::int64_t>();
+    }
+    EXPECT_GT(cells, 0);
+    EXPECT_GT(s["1"].get<std::int64_t>() + s["2"].get<std::int64_t>() + s["5"].get<std::int64_t>(), 0);
+}
+
+TEST(Cli, ExtractSummaryLineAndRepeat)
+{
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    const Result r = run("extract " + sphere + " -i " + kIso + " -o " + quote((dir / "s.ply").string()));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+    for (const char* part : {"sphere.nrrd: 20x20x20 double", "iso -3.8", "cmc33: ", " vertices, ", " triangles in ",
+                             "euler 2", "components 1", "boundary edges 0", "non-manifold edges 0", "s.ply)"}) {
+        EXPECT_NE(r.out.find(part), std::string::npos) << part << " not in " << r.out;
+    }
+
+    const Result rep = run("extract " + sphere + " -i " + kIso + " --repeat 3 --json --method mc33-lewiner");
+    ASSERT_EQ(rep.code, 0) << rep.err;
+    const json j = parse(rep);
+    ASSERT_EQ(j["runs_seconds"].size(), 3u);
+    std::vector<double> runs = j["runs_seconds"].get<std::vector<double>>();
+    std::sort(runs.begin(), runs.end());
+    EXPECT_DOUBLE_EQ(j["seconds"].get<double>(), runs[1]);
+    EXPECT_EQ(j["method"], "mc33-lewiner");
+}
+
+TEST(Cli, ExtractHeaderlessRaw)
+{
+    const fs::path dir = test::temp_dir();
+    const json from_nrrd = parse(run("extract " + quote(write_sphere(dir).string()) + " -i " + kIso + " --json"));
+    const fs::path raw = write_sphere(dir, "sphere.raw");
+    const Result r = run("extract " + quote(raw.string()) + " -i " + kIso +
+                         " --dims 20 20 20 --type double --spacing 1 1 1 --endian little --header-bytes 0 --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    EXPECT_EQ(j["vertices"], from_nrrd["vertices"]);
+    EXPECT_EQ(j["triangles"], from_nrrd["triangles"]);
+    EXPECT_EQ(j["input"]["type"], "double");
+    expect_usage_error(run("extract " + quote(raw.string()) + " -i 1"));              // no --dims/--type
+    expect_usage_error(run("extract " + quote(raw.string()) + " -i 1 --dims 20 20 20")); // no --type
+    // the raw file is too short for these dimensions
+    expect_failure(run("extract " + quote(raw.string()) + " -i 1 --dims 40 40 40 --type double"), "sphere.raw");
+}
+
+TEST(Cli, ExtractFailuresExitOneNamingTheFile)
+{
+    const fs::path dir = test::temp_dir();
+    const fs::path sphere = write_sphere(dir);
+
+    const fs::path missing = dir / "missing.nrrd";
+    expect_failure(run("extract " + quote(missing.string()) + " -i 1"), "missing.nrrd");
+
+    const std::string whole = test::read_file(sphere);
+    const fs::path truncated = dir / "truncated.nrrd";
+    test::write_file(truncated, whole.substr(0, whole.size() - 100));
+    expect_failure(run("extract " + quote(truncated.string()) + " -i " + kIso), "truncated.nrrd");
+
+    Volume nan_volume(ScalarType::f32, {4, 4, 4});
+    nan_volume.samples<float>()[21] = std::numeric_limits<float>::quiet_NaN();
+    const fs::path nan_file = dir / "nan.nrrd";
+    io::write_volume(nan_volume, nan_file);
+    expect_failure(run("extract " + quote(nan_file.string()) + " -i 0.5"), "nan.nrrd");
+
+    expect_failure(run("extract " + quote(sphere.string()) + " --iso nan"), "sphere.nrrd");
+    expect_failure(run("extract " + quote(sphere.string()) + " --iso inf"), "sphere.nrrd");
+
+    // The output is checked before the input is even read: the message is about the output.
+    const Result bad_ext = run("extract " + quote(missing.string()) + " -i 1 -o " + quote((dir / "mesh.xyz").string()));
+    expect_failure(bad_ext, "mesh.xyz");
+    EXPECT_NE(bad_ext.err.find(".ply"), std::string::npos) << bad_ext.err;
+
+    const fs::path no_dir = dir / "no" / "such" / "dir" / "mesh.ply";
+    expect_failure(run("extract " + quote(sphere.string()) + " -i " + kIso + " -o " + quote(no_dir.string())), "mesh.ply");
+    EXPECT_FALSE(fs::exists(dir / "no"));
+
+    // The target is a directory: nothing is written, nothing is left behind.
+    fs::create_directory(dir / "taken.ply");
+    const std::vector<std::string> before = files_in(dir);
+    expect_failure(run("extract " + quote(sphere.string()) + " -i " + kIso + " -o " + quote((dir / "taken.ply").string())),
+                   "taken.ply");
+    EXPECT_EQ(files_in(dir), before);
+    EXPECT_TRUE(fs::is_empty(dir / "taken.ply"));
+
+    expect_failure(run("topo " + quote((dir / "missing.ply").string())), "missing.ply");
+    expect_failure(run("topo " + quote(sphere.string())), "sphere.nrrd"); // not a mesh extension
+    expect_failure(run("info " + quote(truncated.string())), "truncated.nrrd");
+}
+
+// ---- info -------------------------------------------------------------------------------------
+
+TEST(Cli, InfoPrintsDimsRangeAndHistogram)
+{
+    const fs::path dir = test::temp_dir();
+    const fs::path sphere = write_sphere(dir);
+    const auto [lo, hi] = value_range(sphere_volume());
+
+    const Result r = run("info " + quote(sphere.string()));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("20x20x20 double"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("values "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--iso "), std::string::npos) << r.out;
+
+    const Result jr = run("info " + quote(sphere.string()) + " --json");
+    ASSERT_EQ(jr.code, 0) << jr.err;
+    const json j = parse(jr);
+    EXPECT_EQ(j["dims"], json({20, 20, 20}));
+    EXPECT_EQ(j["type"], "double");
+    EXPECT_DOUBLE_EQ(j["min"].get<double>(), lo);
+    EXPECT_DOUBLE_EQ(j["max"].get<double>(), hi);
+    EXPECT_EQ(j["non_finite"]["count"], 0);
+    ASSERT_EQ(j["histogram"].size(), 16u);
+    std::int64_t total = 0;
+    for (const json& bin : j["histogram"]) total += bin["count"].get<std::int64_t>();
+    EXPECT_EQ(total, 8000);
+    EXPECT_DOUBLE_EQ(j["histogram"][0]["lo"].get<double>(), lo);
+    EXPECT_DOUBLE_EQ(j["histogram"][15]["hi"].get<double>(), hi);
+    ASSERT_FALSE(j["candidate_isovalues"].empty());
+    for (const json& c : j["candidate_isovalues"]) {
+        EXPECT_GT(c["iso"].get<double>(), lo);
+        EXPECT_LT(c["iso"].get<double>(), hi);
+    }
+
+    // NaN samples are counted, not refused
+    Volume v(ScalarType::f32, {3, 3, 3});
+    v.samples<float>()[5] = std::numeric_limits<float>::infinity();
+    v.samples<float>()[7] = 2.5f;
+    io::write_volume(v, dir / "inf.nrrd");
+    const Result bad = run("info " + quote((dir / "inf.nrrd").string()) + " --json");
+    ASSERT_EQ(bad.code, 0) << bad.err;
+    const json bj = parse(bad);
+    EXPECT_EQ(bj["non_finite"]["count"], 1);
+    EXPECT_EQ(bj["non_finite"]["first"], json({2, 1, 0}));
+    EXPECT_EQ(bj["max"], 2.5);
+}
+
+// ---- cell -------------------------------------------------------------------------------------
+
+TEST(Cli, CellOneCorner)
+{
+    const Result r = run("cell 1 0 0 0 0 0 0 0 --iso 0.5 --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    EXPECT_EQ(j["config"], 1);
+    EXPECT_EQ(j["base_case"], 1);
+    EXPECT_EQ(j["subcase"], "1");
+    ASSERT_EQ(j["mesh"]["triangles"].size(), 1u);
+    ASSERT_EQ(j["mesh"]["vertices"].size(), 3u);
+    EXPECT_EQ(j["mesh"]["vertices"][0], json({0.5, 0, 0}));
+    EXPECT_EQ(j["topology"]["euler"], 1);
+    EXPECT_EQ(j["topology"]["components"], 1);
+    EXPECT_EQ(j["topology"]["boundary_loops"], 1);
+    ASSERT_EQ(j["faces"].size(), 6u);
+    for (const json& f : j["faces"]) {
+        for (const char* key : {"ambiguous", "saddle", "joined", "used"}) EXPECT_TRUE(f.contains(key)) << key;
+        EXPECT_EQ(f["ambiguous"], false);
+    }
+    EXPECT_EQ(j["interior"]["tested"], false);
+
+    const Result text = run("cell 1 0 0 0 0 0 0 0 -i 0.5");
+    ASSERT_EQ(text.code, 0) << text.err;
+    EXPECT_NE(text.out.find("subcase 1\n"), std::string::npos) << text.out;
+    EXPECT_NE(text.out.find("1 triangle "), std::string::npos) << text.out;
+}
+
+TEST(Cli, CellNegativeValuesAndInteriorTest)
+{
+    // case 13 (corners 1 2 4 7 above): every face ambiguous, the 13.5 interior test runs
+    for (const std::string values : {"-0.5 0.2 0.3 -0.4 0.6 -0.1 -0.7 0.8", "-.5 .2 .3 -.4 .6 -.1 -.7 .8"}) {
+        SCOPED_TRACE(values);
+        const Result r = run("cell " + values + " --json");
+        ASSERT_EQ(r.code, 0) << r.err;
+        const json j = parse(r);
+        EXPECT_EQ(j["config"], 2 + 4 + 16 + 128);
+        EXPECT_EQ(j["base_case"], 13);
+        EXPECT_EQ(j["values"][0], -0.5);
+        for (const json& f : j["faces"]) {
+            EXPECT_EQ(f["ambiguous"], true);
+            EXPECT_EQ(f["used"], true);
+            EXPECT_TRUE(f["saddle"].is_number());
+        }
+        const json& in = j["interior"];
+        for (const char* key : {"tested", "test", "axis", "corner_a", "corner_c", "a", "b", "c", "t1", "t2", "t_max",
+                                "f_t_max", "lewiner_axis", "lewiner_corner", "lewiner_edge", "t_alt", "f_t_alt",
+                                "saddle1", "saddle2", "skipped", "tunnel", "tunnel_corner"}) {
+            EXPECT_TRUE(in.contains(key)) << key;
+        }
+        EXPECT_EQ(in["tested"], true);
+        EXPECT_EQ(in["test"], "13.5");
+        EXPECT_EQ(in["corner_c"].get<int>(), in["corner_a"].get<int>() ^ 7);
+        EXPECT_GT(j["mesh"]["triangles"].size(), 0u);
+        for (const char* key : {"euler", "betti", "boundary_loops", "components"}) {
+            EXPECT_TRUE(j["topology"].contains(key)) << key;
+        }
+    }
+    // options may come first; values may then follow
+    const Result first = run("cell --iso -0.25 --method mc -0.5 1 1 1 1 1 1 1");
+    ASSERT_EQ(first.code, 0) << first.err;
+    EXPECT_NE(first.out.find("method mc, iso -0.25"), std::string::npos) << first.out;
+    expect_failure(run("cell 1 1 1 1 1 1 1 nan"), "corner 7");
+}
+
+TEST(Cli, CellWritesItsMesh)
+{
+    const fs::path dir = test::temp_dir();
+    const fs::path out = dir / "cell.off";
+    const Result r = run("cell 1 1 0 0 0 0 0 0 --iso 0.5 -o " + quote(out.string())); // case 2
+    ASSERT_EQ(r.code, 0) << r.err;
+    ASSERT_TRUE(fs::exists(out));
+    const json t = parse(run("topo " + quote(out.string()) + " --json"));
+    EXPECT_EQ(t["vertices"], 4);
+    EXPECT_EQ(t["faces"], 2);
+    EXPECT_EQ(t["components"], 1);
+    EXPECT_EQ(t["boundary_loops"], 1);
+}
+
+// ---- shared volumes ---------------------------------------------------------------------------
+
+void expect_manifold_mc(const std::string& file, const std::string& iso)
+{
+    const auto path = test::shared_volume(file);
+    if (!path) GTEST_SKIP() << file << " not found (../shared absent)";
+    const Result r = run("extract " + quote(path->string()) + " --iso " + iso + " --method mc --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    EXPECT_GT(j["triangles"].get<std::int64_t>(), 10000);
+    EXPECT_EQ(j["topology"]["nonmanifold_edges"], 0);
+    EXPECT_EQ(j["topology"]["nonmanifold_vertices"], 0);
+    EXPECT_EQ(j["input"]["dims"], json({256, 256, 256}));
+}
+
+TEST(CliShared, AneurismMcIsManifold) { expect_manifold_mc("aneurism_256x256x256_uint8.nrrd", "80"); }
+TEST(CliShared, BonsaiMcIsManifold) { expect_manifold_mc("bonsai_256x256x256_uint8.nrrd", "40"); }
+
+} // namespace
+} // namespace cmc33
