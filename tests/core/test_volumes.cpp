@@ -1,0 +1,94 @@
+// Every volume of ../shared/data/volumes at a README isovalue, once at an integer (exact ties on
+// integer data) and once halfway between integers: the cmc33 mesh is manifold, consistently
+// oriented, and has boundary edges only where the surface meets the volume's outer faces.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/topology.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+struct Case {
+    const char* file;
+    double iso; // an integer; the test also runs iso + 0.5
+};
+
+const Case kCases[] = {
+    {"aneurism_256x256x256_uint8.nrrd", 80},  {"bonsai_256x256x256_uint8.nrrd", 40},
+    {"engine_256x256x128_uint8.nrrd", 80},    {"tooth_103x94x161_uint8.nrrd", 120},
+    {"nucleon_41x41x41_uint8.nrrd", 100},     {"silicium_98x34x34_uint8.nrrd", 100},
+    {"CThead_256x256x113_uint16.nrrd", 650},  {"headsq_quarter_64x64x93_uint16.nrrd", 500},
+    {"ironProt_68x68x68_uint8.nrrd", 96},     {"neghip_66x66x66_uint8.nrrd", 90},
+    {"Bucky_32x32x32_uint8.nrrd", 100},       {"HeadMRVolume_48x62x42_uint8.nrrd", 40},
+    {"mri_head_256x256x256_uint8.nrrd", 38},  {"LIDC2_256x256x133_uint8.nrrd", 60},
+    {"stent_128x128x256_int16.nrrd", 250},    {"walnut_128x96x114_uint16.nrrd", 5000},
+    {"stagbeetle_138x138x82_uint16.nrrd", 900}, {"Cranium_256x256x108_int16.nrrd", 226},
+    {"ch2_181x217x181_uint8.nrrd", 30},
+};
+
+class RealVolume : public ::testing::TestWithParam<Case> {};
+
+TEST_P(RealVolume, ManifoldOrientedBoundaryOnlyOnTheBox)
+{
+    const auto path = cmc33::test::shared_volume(GetParam().file);
+    if (!path) GTEST_SKIP() << "../shared/data/volumes not present";
+    const cmc33::Volume v = cmc33::io::read_volume(*path);
+    for (double iso : {GetParam().iso, GetParam().iso + 0.5}) {
+        SCOPED_TRACE("iso " + std::to_string(iso));
+        const cmc33::Mesh mesh = cmc33::extract(v, iso);
+        const cmc33::MeshTopology t = cmc33::mesh_topology(mesh);
+        EXPECT_GT(t.faces, 0);
+        EXPECT_EQ(t.nonmanifold_edges, 0);
+        EXPECT_EQ(t.nonmanifold_vertices, 0);
+        EXPECT_EQ(t.degenerate_triangles, 0);
+        EXPECT_TRUE(t.oriented);
+        // boundary edges: both ends on an outer face of the volume
+        float lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = static_cast<float>(v.origin()[a] + v.spacing()[a] * 0.0);
+            hi[a] = static_cast<float>(v.origin()[a] + v.spacing()[a] * static_cast<double>(v.dims()[a] - 1));
+        }
+        const auto on_box = [&](std::uint32_t id) {
+            const float* p = &mesh.positions[3 * static_cast<std::size_t>(id)];
+            for (int a = 0; a < 3; ++a)
+                if (p[a] == lo[a] || p[a] == hi[a]) return true;
+            return false;
+        };
+        std::vector<std::uint64_t> edges;
+        edges.reserve(mesh.triangles.size());
+        for (std::size_t f = 0; f < mesh.triangle_count(); ++f)
+            for (int s = 0; s < 3; ++s) {
+                const std::uint64_t a = mesh.triangles[3 * f + static_cast<std::size_t>(s)];
+                const std::uint64_t b = mesh.triangles[3 * f + static_cast<std::size_t>((s + 1) % 3)];
+                edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+            }
+        std::sort(edges.begin(), edges.end());
+        std::int64_t boundary = 0, off_box = 0;
+        for (std::size_t e = 0; e < edges.size();) {
+            std::size_t n = 1;
+            while (e + n < edges.size() && edges[e + n] == edges[e]) ++n;
+            if (n == 1) {
+                ++boundary;
+                off_box += !(on_box(static_cast<std::uint32_t>(edges[e] >> 32)) && on_box(static_cast<std::uint32_t>(edges[e] & 0xffffffffu)));
+            }
+            e += n;
+        }
+        EXPECT_EQ(boundary, t.boundary_edges);
+        EXPECT_EQ(off_box, 0);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(SharedVolumes, RealVolume, ::testing::ValuesIn(kCases), [](const auto& p) {
+    std::string name = p.param.file;
+    name = name.substr(0, name.find('_'));
+    return name;
+});
+
+} // namespace
