@@ -15,6 +15,7 @@
 #include <cstring>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cmc33/error.hpp"
@@ -29,16 +30,109 @@ namespace {
 
 using detail::kEdgeCorners;
 
-/// The sign rule for samples of type T: v >= iso. For integer types the comparison is done
-/// exactly against ceil(iso), so a uint8 sample 80 at iso 80 is above.
-template <class T> struct Above {
-    double iso;
-    explicit Above(double i) : iso(i) {}
-    bool operator()(T v) const { return static_cast<double>(v) >= iso; }
+/// The sign rule for samples of type T: v >= iso. Integer samples are compared in their own type
+/// against ceil(iso) (exact, and cheap in the hot loop); floating-point samples in double.
+template <class T> class Above {
+public:
+    explicit Above(double iso) : iso_(iso)
+    {
+        if constexpr (std::is_integral_v<T>) {
+            const double t = std::ceil(iso);
+            if (t <= static_cast<double>(std::numeric_limits<T>::lowest())) {
+                mode_ = Mode::all;
+            } else if (t > static_cast<double>(std::numeric_limits<T>::max())) {
+                mode_ = Mode::none;
+            } else {
+                threshold_ = static_cast<T>(t);
+            }
+        }
+    }
+    bool operator()(T v) const
+    {
+        if constexpr (std::is_integral_v<T>) {
+            return mode_ == Mode::compare ? v >= threshold_ : mode_ == Mode::all;
+        } else {
+            return static_cast<double>(v) >= iso_;
+        }
+    }
+    /// flags[i] = 1 if row[i] is above, else 0.
+    void row(const T* row, std::int64_t n, std::uint8_t* flags) const
+    {
+        if constexpr (std::is_integral_v<T>) {
+            if (mode_ != Mode::compare) {
+                std::memset(flags, mode_ == Mode::all ? 1 : 0, static_cast<std::size_t>(n));
+                return;
+            }
+            const T t = threshold_;
+            for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i] >= t);
+        } else {
+            const double iso = iso_;
+            for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i]) >= iso);
+        }
+    }
+
+private:
+    enum class Mode { compare, all, none };
+    double iso_;
+    Mode mode_ = Mode::compare;
+    T threshold_{};
 };
 
 constexpr std::int64_t kCornerOffset[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
                                               {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+
+/// A column code holds the above-flags of the four samples (i, j, k), (i, j+1, k), (i, j, k+1),
+/// (i, j+1, k+1) in bits 0..3. Two neighbouring columns make a cell:
+/// kCellCode[col(i) | col(i+1) << 4] is the cell's case code (bit c: corner c above).
+constexpr std::array<std::uint8_t, 256> kCellCode = [] {
+    std::array<std::uint8_t, 256> table{};
+    for (unsigned pair = 0; pair < 256; ++pair) {
+        unsigned code = 0;
+        for (unsigned c = 0; c < 8; ++c) code |= ((pair >> (4 * (c & 1u) + (c >> 1))) & 1u) << c;
+        table[pair] = static_cast<std::uint8_t>(code);
+    }
+    return table;
+}();
+
+/// Rows of `len` values keyed by row number, least recently used evicted first. A pointer it
+/// returns stays valid until `slots` other rows have been asked for.
+template <class V> class RowCache {
+public:
+    RowCache(int slots, std::size_t len)
+        : data_(static_cast<std::size_t>(slots) * len), key_(static_cast<std::size_t>(slots), -1),
+          used_(static_cast<std::size_t>(slots), 0), extra_(static_cast<std::size_t>(slots), 0), len_(len)
+    {
+    }
+    /// The row `key`; `fresh` is set when its slot was taken over and must be filled.
+    V* get(std::int64_t key, bool& fresh, std::int64_t*& extra)
+    {
+        std::size_t victim = 0;
+        for (std::size_t s = 0; s < key_.size(); ++s) {
+            if (key_[s] == key) {
+                used_[s] = ++clock_;
+                fresh = false;
+                extra = &extra_[s];
+                return &data_[s * len_];
+            }
+            if (used_[s] < used_[victim]) victim = s;
+        }
+        key_[victim] = key;
+        used_[victim] = ++clock_;
+        fresh = true;
+        extra = &extra_[victim];
+        return &data_[victim * len_];
+    }
+
+private:
+    std::vector<V> data_;
+    std::vector<std::int64_t> key_;
+    std::vector<std::uint64_t> used_;
+    std::vector<std::int64_t> extra_;
+    std::size_t len_;
+    std::uint64_t clock_ = 0;
+};
+
+constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 
 template <class T> class Extractor {
 public:
@@ -46,6 +140,11 @@ public:
         : g_(g), iso_(iso), above_(iso), opt_(opt), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()),
           threads_(detail::resolve_threads(opt.threads))
     {
+        for (unsigned code = 0; code < 256; ++code) {
+            const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
+            needs_values_[code] = opt.method != Method::mc &&
+                                  (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
+        }
     }
 
     Mesh run(ExtractStats* stats)
@@ -58,13 +157,16 @@ public:
 
         // Pass 1: classify, decide, count.
         detail::parallel_chunks(nz_, threads_, [&](int t, std::int64_t k0, std::int64_t k1) {
+            Scratch scratch(nx_);
             for (std::int64_t k = k0; k < k1; ++k)
-                for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, per_thread[static_cast<std::size_t>(t)]);
+                for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, scratch, per_thread[static_cast<std::size_t>(t)]);
         });
         if (stats) {
             *stats = {};
             for (const auto& s : per_thread)
-                for (int i = 0; i < kSubcaseCount; ++i) stats->cells_per_subcase[static_cast<std::size_t>(i)] += s.cells_per_subcase[static_cast<std::size_t>(i)];
+                for (std::size_t i = 0; i < static_cast<std::size_t>(kSubcaseCount); ++i) {
+                    stats->cells_per_subcase[i] += s.cells_per_subcase[i];
+                }
         }
 
         // Pass 2: exclusive scan (row r's counts are stored at r + 1).
@@ -73,7 +175,7 @@ public:
             row_triangles_[static_cast<std::size_t>(r) + 1] += row_triangles_[static_cast<std::size_t>(r)];
         }
         const std::int64_t nv = row_vertices_.back(), nt = row_triangles_.back();
-        if (nv > static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max())) {
+        if (nv >= static_cast<std::int64_t>(kNoVertex)) {
             throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
                                                " vertices, more than 32-bit indices can address");
         }
@@ -84,21 +186,30 @@ public:
 
         // Passes 3 and 4: emit.
         detail::parallel_chunks(nz_, threads_, [&](int, std::int64_t k0, std::int64_t k1) {
-            RowIds ids(nx_);
+            Scratch scratch(nx_);
             for (std::int64_t k = k0; k < k1; ++k)
                 for (std::int64_t j = 0; j < ny_; ++j) {
-                    emit_row_vertices(j, k, mesh);
-                    if (j + 1 < ny_ && k + 1 < nz_) emit_row_cells(j, k, mesh, ids);
+                    std::int64_t interior_start = 0;
+                    const std::uint32_t* ids = row_ids(j, k, scratch, interior_start);
+                    emit_row_vertices(j, k, ids, mesh);
+                    if (j + 1 < ny_ && k + 1 < nz_) emit_row_cells(j, k, scratch, interior_start, mesh);
                 }
         });
         return mesh;
     }
 
 private:
-    // Vertex ids of the edges owned by one row of samples: ids[3 * i + axis], or -1.
-    struct RowIds {
-        explicit RowIds(std::int64_t nx) : rows(4, std::vector<std::int64_t>(static_cast<std::size_t>(3 * nx))) {}
-        std::vector<std::vector<std::int64_t>> rows; // rows (j,k), (j+1,k), (j,k+1), (j+1,k+1)
+    /// One thread's working rows: above-flags of sample rows, vertex ids of the edges sample rows
+    /// own, and the column codes of the current cell row. O(nx) memory.
+    struct Scratch {
+        explicit Scratch(std::int64_t nx)
+            : flags(16, static_cast<std::size_t>(nx)), ids(6, static_cast<std::size_t>(3 * nx)),
+              columns(static_cast<std::size_t>(nx))
+        {
+        }
+        RowCache<std::uint8_t> flags;
+        RowCache<std::uint32_t> ids;
+        std::vector<std::uint8_t> columns;
     };
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
@@ -108,45 +219,98 @@ private:
         return static_cast<std::size_t>(i + (nx_ - 1) * (j + (ny_ - 1) * k));
     }
 
-    /// Does the edge owned by sample (i, j, k) along `axis` cross? (It must exist.)
-    bool edge_crosses(std::int64_t i, std::int64_t j, std::int64_t k, int axis) const
+    /// Above-flags of the samples of row (j, k).
+    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s) const
     {
-        const T a = at(i, j, k);
-        const T b = axis == 0 ? at(i + 1, j, k) : axis == 1 ? at(i, j + 1, k) : at(i, j, k + 1);
-        return above_(a) != above_(b);
+        bool fresh = false;
+        std::int64_t* unused = nullptr;
+        std::uint8_t* f = s.flags.get(row_index(j, k), fresh, unused);
+        if (fresh) above_.row(g_.data + g_.offset(0, j, k), nx_, f);
+        return f;
     }
 
-    unsigned case_code(std::int64_t i, std::int64_t j, std::int64_t k, double* values) const
+    /// Column codes of cell row (j, k) into s.columns (see kCellCode).
+    void column_codes(std::int64_t j, std::int64_t k, Scratch& s) const
     {
-        unsigned code = 0;
-        for (int c = 0; c < 8; ++c) {
-            const T s = at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
-            if (values) values[c] = static_cast<double>(s) - iso_;
-            code |= static_cast<unsigned>(above_(s)) << c;
-        }
-        return code;
-    }
-
-    void count_row(std::int64_t j, std::int64_t k, ExtractStats& stats)
-    {
-        std::int64_t vertices = 0, triangles = 0;
+        const std::uint8_t* f00 = flags(j, k, s);
+        const std::uint8_t* f10 = flags(j + 1, k, s);
+        const std::uint8_t* f01 = flags(j, k + 1, s);
+        const std::uint8_t* f11 = flags(j + 1, k + 1, s);
+        std::uint8_t* col = s.columns.data();
         for (std::int64_t i = 0; i < nx_; ++i) {
-            if (i + 1 < nx_) vertices += edge_crosses(i, j, k, 0);
-            if (j + 1 < ny_) vertices += edge_crosses(i, j, k, 1);
-            if (k + 1 < nz_) vertices += edge_crosses(i, j, k, 2);
+            col[i] = static_cast<std::uint8_t>(f00[i] | f10[i] << 1 | f01[i] << 2 | f11[i] << 3);
+        }
+    }
+
+    /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
+    /// where the edge does not cross or does not exist. `interior_start`: the id after the row's
+    /// last edge vertex, where the interior vertices of its cells begin.
+    const std::uint32_t* row_ids(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& interior_start) const
+    {
+        bool fresh = false;
+        std::int64_t* end = nullptr;
+        std::uint32_t* ids = s.ids.get(row_index(j, k), fresh, end);
+        if (fresh) {
+            const std::uint8_t* f = flags(j, k, s);
+            const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+            const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+            auto id = static_cast<std::uint32_t>(row_vertices_[static_cast<std::size_t>(row_index(j, k))]);
+            for (std::int64_t i = 0; i < nx_; ++i) {
+                const bool cx = i + 1 < nx_ && f[i] != f[i + 1];
+                ids[3 * i] = cx ? id : kNoVertex;
+                id += cx;
+                const bool cy = f[i] != fy[i];
+                ids[3 * i + 1] = cy ? id : kNoVertex;
+                id += cy;
+                const bool cz = f[i] != fz[i];
+                ids[3 * i + 2] = cz ? id : kNoVertex;
+                id += cz;
+            }
+            *end = id;
+        }
+        interior_start = *end;
+        return ids;
+    }
+
+    void count_row(std::int64_t j, std::int64_t k, Scratch& s, ExtractStats& stats)
+    {
+        const std::uint8_t* f = flags(j, k, s);
+        std::int64_t vertices = 0, triangles = 0;
+        for (std::int64_t i = 0; i + 1 < nx_; ++i) vertices += f[i] != f[i + 1];
+        if (j + 1 < ny_) {
+            const std::uint8_t* fy = flags(j + 1, k, s);
+            for (std::int64_t i = 0; i < nx_; ++i) vertices += f[i] != fy[i];
+        }
+        if (k + 1 < nz_) {
+            const std::uint8_t* fz = flags(j, k + 1, s);
+            for (std::int64_t i = 0; i < nx_; ++i) vertices += f[i] != fz[i];
         }
         if (j + 1 < ny_ && k + 1 < nz_) {
-            double v[8];
+            column_codes(j, k, s);
+            const std::uint8_t* col = s.columns.data();
             for (std::int64_t i = 0; i + 1 < nx_; ++i) {
-                const unsigned code = case_code(i, j, k, v);
+                const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
                 if (code == 0 || code == 255) continue;
-                const detail::Decision d = detail::decide(v, code, opt_.method);
-                const detail::Tiling& tl = d.variant->tilings[d.tiling];
-                decisions_[cell_index(i, j, k)] =
-                    static_cast<std::uint8_t>((d.variant - &detail::kVariants[detail::kVariantOffset[code]]) | d.tiling << 6);
+                const detail::Variant* variant = &detail::kVariants[detail::kVariantOffset[code]];
+                unsigned tiling = 0;
+                int subcase = variant->subcase;
+                if (needs_values_[code]) {
+                    double v[8];
+                    for (int c = 0; c < 8; ++c) {
+                        v[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1],
+                                                      k + kCornerOffset[c][2])) - iso_;
+                    }
+                    const detail::Decision d = detail::decide(v, code, opt_.method);
+                    decisions_[cell_index(i, j, k)] = static_cast<std::uint8_t>(
+                        (d.variant - variant) | d.tiling << 6);
+                    variant = d.variant;
+                    tiling = static_cast<unsigned>(d.tiling);
+                    subcase = d.subcase;
+                }
+                const detail::Tiling& tl = variant->tilings[tiling];
                 vertices += tl.interior_count;
                 triangles += tl.triangle_count;
-                ++stats.cells_per_subcase[static_cast<std::size_t>(d.subcase)];
+                ++stats.cells_per_subcase[static_cast<std::size_t>(subcase)];
             }
         }
         row_vertices_[static_cast<std::size_t>(row_index(j, k)) + 1] = vertices;
@@ -176,28 +340,25 @@ private:
         return grad;
     }
 
-    void emit_row_vertices(std::int64_t j, std::int64_t k, Mesh& mesh) const
+    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Mesh& mesh) const
     {
-        std::int64_t id = row_vertices_[static_cast<std::size_t>(row_index(j, k))];
-        for (std::int64_t i = 0; i < nx_; ++i) {
-            for (int axis = 0; axis < 3; ++axis) {
-                const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
-                if (end[0] >= nx_ || end[1] >= ny_ || end[2] >= nz_) continue;
-                const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
-                if (above_(a) == above_(b)) continue;
-                const double t = crossing(a, b);
-                const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
-                float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
-                for (int c = 0; c < 3; ++c) {
-                    const double x = p[c] + (c == axis ? t : 0.0);
-                    out[c] = static_cast<float>(g_.origin[static_cast<std::size_t>(c)] + g_.spacing[static_cast<std::size_t>(c)] * x);
-                }
-                if (opt_.normals) {
-                    const auto ga = gradient(i, j, k), gb = gradient(end[0], end[1], end[2]);
-                    write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3],
-                                 {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
-                }
-                ++id;
+        for (std::int64_t slot = 0; slot < 3 * nx_; ++slot) {
+            const std::uint32_t id = ids[slot];
+            if (id == kNoVertex) continue;
+            const std::int64_t i = slot / 3;
+            const int axis = static_cast<int>(slot % 3);
+            const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
+            const double t = crossing(at(i, j, k), at(end[0], end[1], end[2]));
+            const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+            float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
+            for (int c = 0; c < 3; ++c) {
+                const double x = p[c] + (c == axis ? t : 0.0);
+                out[c] = static_cast<float>(g_.origin[static_cast<std::size_t>(c)] + g_.spacing[static_cast<std::size_t>(c)] * x);
+            }
+            if (opt_.normals) {
+                const auto ga = gradient(i, j, k), gb = gradient(end[0], end[1], end[2]);
+                write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3],
+                             {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
             }
         }
     }
@@ -209,41 +370,26 @@ private:
         for (int c = 0; c < 3; ++c) out[c] = len > 0 ? static_cast<float>(-g[static_cast<std::size_t>(c)] / len) : 0.0f;
     }
 
-    /// Returns the id after the row's last edge vertex: where its cells' interior vertices start.
-    std::int64_t fill_row_ids(std::int64_t j, std::int64_t k, std::vector<std::int64_t>& ids) const
+    void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t vertex, Mesh& mesh) const
     {
-        std::int64_t id = row_vertices_[static_cast<std::size_t>(row_index(j, k))];
-        for (std::int64_t i = 0; i < nx_; ++i) {
-            for (int axis = 0; axis < 3; ++axis) {
-                std::int64_t& slot = ids[static_cast<std::size_t>(3 * i + axis)];
-                slot = -1;
-                const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
-                if (end[0] >= nx_ || end[1] >= ny_ || end[2] >= nz_) continue;
-                if (above_(at(i, j, k)) != above_(at(end[0], end[1], end[2]))) slot = id++;
-            }
-        }
-        return id;
-    }
-
-    void emit_row_cells(std::int64_t j, std::int64_t k, Mesh& mesh, RowIds& ids) const
-    {
-        std::int64_t vertex = fill_row_ids(j, k, ids.rows[0]); // the row's interior vertices follow its edges
-        fill_row_ids(j + 1, k, ids.rows[1]);
-        fill_row_ids(j, k + 1, ids.rows[2]);
-        fill_row_ids(j + 1, k + 1, ids.rows[3]);
-        const std::int64_t r = row_index(j, k);
-        std::int64_t tri = row_triangles_[static_cast<std::size_t>(r)];
+        // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
+        std::int64_t unused = 0;
+        const std::uint32_t* ids[4] = {row_ids(j, k, s, unused), row_ids(j + 1, k, s, unused),
+                                       row_ids(j, k + 1, s, unused), row_ids(j + 1, k + 1, s, unused)};
+        column_codes(j, k, s);
+        const std::uint8_t* col = s.columns.data();
+        std::int64_t tri = row_triangles_[static_cast<std::size_t>(row_index(j, k))];
         for (std::int64_t i = 0; i + 1 < nx_; ++i) {
-            const unsigned code = case_code(i, j, k, nullptr);
+            const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
             if (code == 0 || code == 255) continue;
             const std::uint8_t dec = decisions_[cell_index(i, j, k)];
             const detail::Variant& var = detail::kVariants[detail::kVariantOffset[code] + (dec & 63u)];
             const detail::Tiling& tl = var.tilings[dec >> 6];
-            std::int64_t edge_id[12];
+            std::uint32_t edge_id[12];
             for (int e = 0; e < 12; ++e) {
                 const int c = kEdgeCorners[e][0];
-                const std::size_t row = static_cast<std::size_t>(kCornerOffset[c][1] + 2 * kCornerOffset[c][2]);
-                edge_id[e] = ids.rows[row][static_cast<std::size_t>(3 * (i + kCornerOffset[c][0]) + e / 4)];
+                const std::uint32_t* row = ids[kCornerOffset[c][1] + 2 * kCornerOffset[c][2]];
+                edge_id[e] = row[3 * (i + kCornerOffset[c][0]) + e / 4];
             }
             const std::int64_t first_interior = vertex;
             for (int q = 0; q < tl.interior_count; ++q) {
@@ -253,7 +399,7 @@ private:
             std::uint32_t* out = &mesh.triangles[static_cast<std::size_t>(tri) * 3];
             for (int q = 0; q < 3 * tl.triangle_count; ++q) {
                 const int v = codes[q];
-                out[q] = static_cast<std::uint32_t>(v < 12 ? edge_id[v] : first_interior + (v - 12));
+                out[q] = v < 12 ? edge_id[v] : static_cast<std::uint32_t>(first_interior + (v - 12));
             }
             tri += tl.triangle_count;
         }
@@ -295,6 +441,7 @@ private:
     ExtractOptions opt_;
     std::int64_t nx_, ny_, nz_;
     int threads_;
+    std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
     std::vector<std::uint8_t> decisions_;
 };

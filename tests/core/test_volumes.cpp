@@ -1,10 +1,12 @@
 // Every volume of ../shared/data/volumes at a README isovalue, once at an integer (exact ties on
 // integer data) and once halfway between integers: the cmc33 mesh is manifold, consistently
-// oriented, and has boundary edges only where the surface meets the volume's outer faces.
+// oriented, has boundary edges only where the surface meets the volume's outer faces, and has the
+// Euler characteristic, Betti numbers and boundary loops of the trilinear interpolant's level set.
 
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -19,6 +21,8 @@ struct Case {
     const char* file;
     double iso; // an integer; the test also runs iso + 0.5
 };
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.file << " at iso " << c.iso; }
 
 const Case kCases[] = {
     {"aneurism_256x256x256_uint8.nrrd", 80},  {"bonsai_256x256x256_uint8.nrrd", 40},
@@ -82,6 +86,14 @@ TEST_P(RealVolume, ManifoldOrientedBoundaryOnlyOnTheBox)
         }
         EXPECT_EQ(boundary, t.boundary_edges);
         EXPECT_EQ(off_box, 0);
+        // and the mesh has the topology of the trilinear level set (src/topology, no shared code)
+        const cmc33::FieldTopology field = cmc33::field_topology(v, iso);
+        ASSERT_TRUE(field.determined) << field.why;
+        EXPECT_EQ(t.euler, field.euler);
+        EXPECT_EQ(t.components, field.b0);
+        EXPECT_EQ(t.b1, field.b1);
+        EXPECT_EQ(t.closed_components, field.b2);
+        EXPECT_EQ(t.boundary_loops, field.boundary_loops);
     }
 }
 
