@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -94,42 +95,33 @@ constexpr std::array<std::uint8_t, 256> kCellCode = [] {
     return table;
 }();
 
-/// Rows of `len` values keyed by row number, least recently used evicted first. A pointer it
-/// returns stays valid until `slots` other rows have been asked for.
+/// Rows of `len` values for sample rows (j, k), direct-mapped on the low `bits` bits of j and k:
+/// a pass over the cell rows of a slab asks for rows j..j+2^bits-1 and k..k+2^bits-1 at once at
+/// most, which never share a slot. Each slot also holds one number (`extra`) about its row.
 template <class V> class RowCache {
 public:
-    RowCache(int slots, std::size_t len)
-        : data_(static_cast<std::size_t>(slots) * len), key_(static_cast<std::size_t>(slots), -1),
-          used_(static_cast<std::size_t>(slots), 0), extra_(static_cast<std::size_t>(slots), 0), len_(len)
+    RowCache(int bits, std::size_t len)
+        : bits_(bits), mask_((std::int64_t{1} << bits) - 1), data_((std::size_t{1} << (2 * bits)) * len),
+          key_(std::size_t{1} << (2 * bits), {-1, -1}), extra_(std::size_t{1} << (2 * bits), 0), len_(len)
     {
     }
-    /// The row `key`; `fresh` is set when its slot was taken over and must be filled.
-    V* get(std::int64_t key, bool& fresh, std::int64_t*& extra)
+    /// Row (j, k); `fresh` is set when its slot held another row and must be filled.
+    V* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& extra)
     {
-        std::size_t victim = 0;
-        for (std::size_t s = 0; s < key_.size(); ++s) {
-            if (key_[s] == key) {
-                used_[s] = ++clock_;
-                fresh = false;
-                extra = &extra_[s];
-                return &data_[s * len_];
-            }
-            if (used_[s] < used_[victim]) victim = s;
-        }
-        key_[victim] = key;
-        used_[victim] = ++clock_;
-        fresh = true;
-        extra = &extra_[victim];
-        return &data_[victim * len_];
+        const auto slot = static_cast<std::size_t>((j & mask_) | (k & mask_) << bits_);
+        fresh = key_[slot][0] != j || key_[slot][1] != k;
+        key_[slot] = {j, k};
+        extra = &extra_[slot];
+        return &data_[slot * len_];
     }
 
 private:
+    int bits_;
+    std::int64_t mask_;
     std::vector<V> data_;
-    std::vector<std::int64_t> key_;
-    std::vector<std::uint64_t> used_;
+    std::vector<std::array<std::int64_t, 2>> key_;
     std::vector<std::int64_t> extra_;
     std::size_t len_;
-    std::uint64_t clock_ = 0;
 };
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
@@ -152,7 +144,9 @@ public:
         const std::int64_t rows = ny_ * nz_;
         row_vertices_.assign(static_cast<std::size_t>(rows) + 1, 0);
         row_triangles_.assign(static_cast<std::size_t>(rows) + 1, 0);
-        decisions_.assign(static_cast<std::size_t>((nx_ - 1) * (ny_ - 1) * (nz_ - 1)), 0);
+        // One byte per cell, written in pass 1 for every cell the surface crosses and read in pass 4
+        // only for those: left uninitialised, so untouched pages cost nothing.
+        decisions_.reset(new std::uint8_t[static_cast<std::size_t>((nx_ - 1) * (ny_ - 1) * (nz_ - 1))]);
         std::vector<ExtractStats> per_thread(static_cast<std::size_t>(threads_));
 
         // Pass 1: classify, decide, count.
@@ -189,10 +183,14 @@ public:
             Scratch scratch(nx_);
             for (std::int64_t k = k0; k < k1; ++k)
                 for (std::int64_t j = 0; j < ny_; ++j) {
-                    std::int64_t interior_start = 0;
-                    const std::uint32_t* ids = row_ids(j, k, scratch, interior_start);
-                    emit_row_vertices(j, k, ids, mesh);
-                    if (j + 1 < ny_ && k + 1 < nz_) emit_row_cells(j, k, scratch, interior_start, mesh);
+                    const auto r = static_cast<std::size_t>(row_index(j, k));
+                    std::int64_t interior_start = row_vertices_[r];
+                    if (row_vertices_[r + 1] != row_vertices_[r]) {
+                        emit_row_vertices(j, k, row_ids(j, k, scratch, interior_start), mesh);
+                    }
+                    if (j + 1 < ny_ && k + 1 < nz_ && row_triangles_[r + 1] != row_triangles_[r]) {
+                        emit_row_cells(j, k, scratch, interior_start, mesh);
+                    }
                 }
         });
         return mesh;
@@ -203,7 +201,7 @@ private:
     /// own, and the column codes of the current cell row. O(nx) memory.
     struct Scratch {
         explicit Scratch(std::int64_t nx)
-            : flags(16, static_cast<std::size_t>(nx)), ids(6, static_cast<std::size_t>(3 * nx)),
+            : flags(2, static_cast<std::size_t>(nx)), ids(1, static_cast<std::size_t>(3 * nx)),
               columns(static_cast<std::size_t>(nx))
         {
         }
@@ -219,14 +217,25 @@ private:
         return static_cast<std::size_t>(i + (nx_ - 1) * (j + (ny_ - 1) * k));
     }
 
-    /// Above-flags of the samples of row (j, k).
-    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s) const
+    /// Above-flags of the samples of row (j, k); `above` counts the samples above.
+    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& above) const
     {
         bool fresh = false;
-        std::int64_t* unused = nullptr;
-        std::uint8_t* f = s.flags.get(row_index(j, k), fresh, unused);
-        if (fresh) above_.row(g_.data + g_.offset(0, j, k), nx_, f);
+        std::int64_t* count = nullptr;
+        std::uint8_t* f = s.flags.get(j, k, fresh, count);
+        if (fresh) {
+            above_.row(g_.data + g_.offset(0, j, k), nx_, f);
+            std::int64_t n = 0;
+            for (std::int64_t i = 0; i < nx_; ++i) n += f[i];
+            *count = n;
+        }
+        above = *count;
         return f;
+    }
+    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s) const
+    {
+        std::int64_t unused = 0;
+        return flags(j, k, s, unused);
     }
 
     /// Column codes of cell row (j, k) into s.columns (see kCellCode).
@@ -249,12 +258,16 @@ private:
     {
         bool fresh = false;
         std::int64_t* end = nullptr;
-        std::uint32_t* ids = s.ids.get(row_index(j, k), fresh, end);
-        if (fresh) {
+        std::uint32_t* ids = s.ids.get(j, k, fresh, end);
+        const std::size_t r = static_cast<std::size_t>(row_index(j, k));
+        if (fresh && row_vertices_[r + 1] == row_vertices_[r]) {
+            // no crossed edge (and no interior vertex): no cell will read these ids
+            *end = row_vertices_[r];
+        } else if (fresh) {
             const std::uint8_t* f = flags(j, k, s);
             const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
             const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
-            auto id = static_cast<std::uint32_t>(row_vertices_[static_cast<std::size_t>(row_index(j, k))]);
+            auto id = static_cast<std::uint32_t>(row_vertices_[r]);
             for (std::int64_t i = 0; i < nx_; ++i) {
                 const bool cx = i + 1 < nx_ && f[i] != f[i + 1];
                 ids[3 * i] = cx ? id : kNoVertex;
@@ -274,7 +287,15 @@ private:
 
     void count_row(std::int64_t j, std::int64_t k, Scratch& s, ExtractStats& stats)
     {
-        const std::uint8_t* f = flags(j, k, s);
+        // Trim: when the sample rows this row's edges and cells reach are all above or all below,
+        // nothing crosses (most rows of a CT volume).
+        std::int64_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
+        const std::uint8_t* f = flags(j, k, s, n0);
+        n1 = n2 = n3 = n0;
+        if (j + 1 < ny_) flags(j + 1, k, s, n1);
+        if (k + 1 < nz_) flags(j, k + 1, s, n2);
+        if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
+        if ((n0 == 0 || n0 == nx_) && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
         std::int64_t vertices = 0, triangles = 0;
         for (std::int64_t i = 0; i + 1 < nx_; ++i) vertices += f[i] != f[i + 1];
         if (j + 1 < ny_) {
@@ -294,6 +315,7 @@ private:
                 const detail::Variant* variant = &detail::kVariants[detail::kVariantOffset[code]];
                 unsigned tiling = 0;
                 int subcase = variant->subcase;
+                decisions_[cell_index(i, j, k)] = 0;
                 if (needs_values_[code]) {
                     double v[8];
                     for (int c = 0; c < 8; ++c) {
@@ -443,7 +465,7 @@ private:
     int threads_;
     std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
-    std::vector<std::uint8_t> decisions_;
+    std::unique_ptr<std::uint8_t[]> decisions_;
 };
 
 template <class T> void validate(const GridView<T>& g, double iso)
