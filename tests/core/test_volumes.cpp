@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cmc33/extract.hpp"
@@ -102,5 +103,31 @@ INSTANTIATE_TEST_SUITE_P(SharedVolumes, RealVolume, ::testing::ValuesIn(kCases),
     name = name.substr(0, name.find('_'));
     return name;
 });
+
+// Real data, with normals and every method: the mesh is the same, byte for byte, whatever the
+// thread count (the bundled Bucky volume always; engine and CThead when ../shared is present).
+TEST(RealVolumeThreads, ByteIdenticalForOneTwoAndSevenThreads)
+{
+    std::vector<std::pair<cmc33::Volume, double>> volumes;
+    volumes.emplace_back(cmc33::io::read_volume(std::string(CMC33_SOURCE_DIR) + "/data/Bucky_32x32x32_uint8.nrrd"), 100.0);
+    for (const auto& [file, iso] : {std::pair{"engine_256x256x128_uint8.nrrd", 80.0},
+                                    std::pair{"CThead_256x256x113_uint16.nrrd", 650.5}}) {
+        if (const auto path = cmc33::test::shared_volume(file)) volumes.emplace_back(cmc33::io::read_volume(*path), iso);
+    }
+    for (const auto& [volume, iso] : volumes) {
+        for (cmc33::Method m : {cmc33::Method::cmc33, cmc33::Method::mc33_lewiner, cmc33::Method::mc}) {
+            cmc33::ExtractOptions opt{m, true, 1};
+            const cmc33::Mesh one = cmc33::extract(volume, iso, opt);
+            ASSERT_GT(one.triangle_count(), 0u);
+            for (int threads : {2, 7}) {
+                opt.threads = threads;
+                const cmc33::Mesh many = cmc33::extract(volume, iso, opt);
+                EXPECT_EQ(one.positions, many.positions) << threads << " threads";
+                EXPECT_EQ(one.normals, many.normals) << threads << " threads";
+                EXPECT_EQ(one.triangles, many.triangles) << threads << " threads";
+            }
+        }
+    }
+}
 
 } // namespace

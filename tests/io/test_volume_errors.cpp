@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <zlib.h>
 
 #include <bit>
 #include <cmath>
@@ -22,32 +21,11 @@
 namespace cmc33::io {
 namespace {
 
+using test::gzip_bytes;
 using test::temp_dir;
+using test::zlib_bytes;
 using test::write_file;
 
-std::string deflate_bytes(const std::string& data, int window_bits)
-{
-    z_stream z{};
-    EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, window_bits, 8, Z_DEFAULT_STRATEGY), Z_OK);
-    std::string out(deflateBound(&z, data.size()) + 64, '\0');
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-    z.avail_in = static_cast<uInt>(data.size());
-    z.next_out = reinterpret_cast<Bytef*>(out.data());
-    z.avail_out = static_cast<uInt>(out.size());
-    EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
-    out.resize(z.total_out);
-    deflateEnd(&z);
-    return out;
-}
-
-std::string gzip_bytes(const std::string& data)
-{
-    return deflate_bytes(data, 31);
-}
-std::string zlib_bytes(const std::string& data)
-{
-    return deflate_bytes(data, 15);
-}
 
 /// Little-endian bytes of 16-bit values.
 std::string le16(const std::vector<int>& values)

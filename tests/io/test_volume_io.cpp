@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <zlib.h>
 
 #include <bit>
 #include <cmath>
@@ -21,35 +20,13 @@ namespace cmc33::io {
 namespace {
 
 using test::read_file;
+using test::gzip_bytes;
 using test::temp_dir;
+using test::zlib_bytes;
 using test::write_file;
 
 // ---- building files -------------------------------------------------------------------------
 
-/// A gzip (window_bits 31) or zlib (15) stream of `data`.
-std::string deflate_bytes(const std::string& data, int window_bits)
-{
-    z_stream z{};
-    EXPECT_EQ(deflateInit2(&z, 6, Z_DEFLATED, window_bits, 8, Z_DEFAULT_STRATEGY), Z_OK);
-    std::string out(deflateBound(&z, data.size()) + 64, '\0');
-    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
-    z.avail_in = static_cast<uInt>(data.size());
-    z.next_out = reinterpret_cast<Bytef*>(out.data());
-    z.avail_out = static_cast<uInt>(out.size());
-    EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
-    out.resize(z.total_out);
-    deflateEnd(&z);
-    return out;
-}
-
-std::string gzip_bytes(const std::string& data)
-{
-    return deflate_bytes(data, 31);
-}
-std::string zlib_bytes(const std::string& data)
-{
-    return deflate_bytes(data, 15);
-}
 
 /// The bytes of `values` in the given byte order.
 template <class T> std::string bytes_of(const std::vector<T>& values, Endian endian)

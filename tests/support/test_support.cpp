@@ -1,12 +1,40 @@
 #include "test_support.hpp"
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 namespace cmc33::test {
+
+namespace {
+
+/// One deflate stream of `data`: window_bits 31 for a gzip wrapper, 15 for zlib.
+std::string deflate_bytes(const std::string& data, int window_bits)
+{
+    z_stream z{};
+    if (deflateInit2(&z, 6, Z_DEFLATED, window_bits, 8, Z_DEFAULT_STRATEGY) != Z_OK) {
+        throw std::runtime_error("deflateInit2 failed");
+    }
+    std::string out(deflateBound(&z, static_cast<uLong>(data.size())) + 64, '\0');
+    z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+    z.avail_in = static_cast<uInt>(data.size());
+    z.next_out = reinterpret_cast<Bytef*>(out.data());
+    z.avail_out = static_cast<uInt>(out.size());
+    const int status = deflate(&z, Z_FINISH);
+    out.resize(z.total_out);
+    deflateEnd(&z);
+    if (status != Z_STREAM_END) throw std::runtime_error("deflate did not finish");
+    return out;
+}
+
+} // namespace
+
+std::string gzip_bytes(const std::string& data) { return deflate_bytes(data, 31); }
+std::string zlib_bytes(const std::string& data) { return deflate_bytes(data, 15); }
 
 std::filesystem::path temp_dir()
 {

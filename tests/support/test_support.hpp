@@ -24,6 +24,10 @@ std::filesystem::path test_data_dir();
 void write_file(const std::filesystem::path& path, const std::string& bytes);
 std::string read_file(const std::filesystem::path& path);
 
+/// `data` compressed as one gzip stream, or as one zlib stream (for building compressed inputs).
+std::string gzip_bytes(const std::string& data);
+std::string zlib_bytes(const std::string& data);
+
 /// A double volume of the given dims filled by f(i, j, k).
 Volume make_volume(Index3 dims, const std::function<double(std::int64_t, std::int64_t, std::int64_t)>& f,
                    Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0});
