@@ -269,6 +269,20 @@ TEST(Cli, ExtractSummaryLineAndRepeat)
     EXPECT_EQ(j["method"], "mc33-lewiner");
 }
 
+TEST(Cli, ExtractNoTopology)
+{
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    const Result r = run("extract " + sphere + " -i " + kIso + " --no-topology --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    const json j = parse(r);
+    EXPECT_TRUE(j["topology"].is_null());
+    EXPECT_GT(j["triangles"].get<std::int64_t>(), 0);
+    const Result line = run("extract " + sphere + " -i " + kIso + " --no-topology");
+    ASSERT_EQ(line.code, 0) << line.err;
+    EXPECT_EQ(line.out.find("euler"), std::string::npos) << line.out;
+}
+
 TEST(Cli, ExtractHeaderlessRaw)
 {
     const fs::path dir = test::temp_dir();
