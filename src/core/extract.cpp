@@ -1,11 +1,13 @@
 // extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges):
-//   1. classify + decide + count: per row of cells, the case code of each cell, its face and
-//      interior tests (run once, the chosen tiling stored in one byte per cell), and the number of
-//      vertices (crossed edges owned by the row's samples, interior vertices) and triangles;
+//   1. classify + decide + count: per row of cells, the case code of each cell from the rows'
+//      above-flags (rows whose samples are all on one side are skipped), the face and interior
+//      tests of the cells that have them, and the number of vertices (crossed edges owned by the
+//      row's samples, interior vertices) and triangles;
 //   2. scan: prefix sums give every row its first vertex and first triangle;
 //   3. emit vertices: each crossed grid edge is owned by its lower sample and gets one vertex;
 //   4. emit triangles: every cell writes its tiling's triangles and interior vertices at its row's
-//      offsets, finding edge vertices by edge ownership (no hash map, no locks).
+//      offsets, finding edge vertices by edge ownership (no hash map, no locks). Tested cells are
+//      decided again rather than stored: working memory is O(rows + threads * nx), not O(cells).
 // Rows are processed in parallel by z-slab; all writes land at offsets fixed by pass 2, so the mesh
 // is the same, byte for byte, for every thread count.
 
@@ -95,6 +97,33 @@ constexpr std::array<std::uint8_t, 256> kCellCode = [] {
     return table;
 }();
 
+/// Above-flags of sample rows, filled row by row on demand, for three consecutive slices at once
+/// (slice k lives in buffer k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at most.
+/// Each row is computed once per thread; `count` holds its number of samples above.
+class SliceFlags {
+public:
+    SliceFlags(std::int64_t nx, std::int64_t ny)
+        : nx_(nx), ny_(ny), flags_(static_cast<std::size_t>(3 * nx * ny)),
+          slice_of_(static_cast<std::size_t>(3 * ny), -1), count_(static_cast<std::size_t>(3 * ny), 0)
+    {
+    }
+    /// The flags of row (j, k); `fresh` when they must be computed (then also set `count`).
+    std::uint8_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& count)
+    {
+        const auto row = static_cast<std::size_t>((k % 3) * ny_ + j);
+        fresh = slice_of_[row] != k;
+        slice_of_[row] = k;
+        count = &count_[row];
+        return &flags_[row * static_cast<std::size_t>(nx_)];
+    }
+
+private:
+    std::int64_t nx_, ny_;
+    std::vector<std::uint8_t> flags_;
+    std::vector<std::int64_t> slice_of_;
+    std::vector<std::int64_t> count_;
+};
+
 /// Rows of `len` values for sample rows (j, k), direct-mapped on the low `bits` bits of j and k:
 /// a pass over the cell rows of a slab asks for rows j..j+2^bits-1 and k..k+2^bits-1 at once at
 /// most, which never share a slot. Each slot also holds one number (`extra`) about its row.
@@ -144,14 +173,13 @@ public:
         const std::int64_t rows = ny_ * nz_;
         row_vertices_.assign(static_cast<std::size_t>(rows) + 1, 0);
         row_triangles_.assign(static_cast<std::size_t>(rows) + 1, 0);
-        // One byte per cell, written in pass 1 for every cell the surface crosses and read in pass 4
-        // only for those: left uninitialised, so untouched pages cost nothing.
-        decisions_.reset(new std::uint8_t[static_cast<std::size_t>((nx_ - 1) * (ny_ - 1) * (nz_ - 1))]);
+        edges_.assign(static_cast<std::size_t>(rows), {0, 0});
+        cells_.assign(static_cast<std::size_t>(rows), {0, 0});
         std::vector<ExtractStats> per_thread(static_cast<std::size_t>(threads_));
 
         // Pass 1: classify, decide, count.
         detail::parallel_chunks(nz_, threads_, [&](int t, std::int64_t k0, std::int64_t k1) {
-            Scratch scratch(nx_);
+            Scratch scratch(nx_, ny_);
             for (std::int64_t k = k0; k < k1; ++k)
                 for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, scratch, per_thread[static_cast<std::size_t>(t)]);
         });
@@ -180,7 +208,7 @@ public:
 
         // Passes 3 and 4: emit.
         detail::parallel_chunks(nz_, threads_, [&](int, std::int64_t k0, std::int64_t k1) {
-            Scratch scratch(nx_);
+            Scratch scratch(nx_, ny_);
             for (std::int64_t k = k0; k < k1; ++k)
                 for (std::int64_t j = 0; j < ny_; ++j) {
                     const auto r = static_cast<std::size_t>(row_index(j, k));
@@ -200,22 +228,17 @@ private:
     /// One thread's working rows: above-flags of sample rows, vertex ids of the edges sample rows
     /// own, and the column codes of the current cell row. O(nx) memory.
     struct Scratch {
-        explicit Scratch(std::int64_t nx)
-            : flags(2, static_cast<std::size_t>(nx)), ids(1, static_cast<std::size_t>(3 * nx)),
-              columns(static_cast<std::size_t>(nx))
+        Scratch(std::int64_t nx, std::int64_t ny)
+            : flags(nx, ny), ids(1, static_cast<std::size_t>(3 * nx)), columns(static_cast<std::size_t>(nx))
         {
         }
-        RowCache<std::uint8_t> flags;
+        SliceFlags flags;
         RowCache<std::uint32_t> ids;
         std::vector<std::uint8_t> columns;
     };
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
     std::int64_t row_index(std::int64_t j, std::int64_t k) const { return j + k * ny_; }
-    std::size_t cell_index(std::int64_t i, std::int64_t j, std::int64_t k) const
-    {
-        return static_cast<std::size_t>(i + (nx_ - 1) * (j + (ny_ - 1) * k));
-    }
 
     /// Above-flags of the samples of row (j, k); `above` counts the samples above.
     const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& above) const
@@ -268,7 +291,8 @@ private:
             const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
             const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
             auto id = static_cast<std::uint32_t>(row_vertices_[r]);
-            for (std::int64_t i = 0; i < nx_; ++i) {
+            // outside the range no edge crosses: those slots are never read for a vertex
+            for (std::int64_t i = edges_[r][0]; i < edges_[r][1]; ++i) {
                 const bool cx = i + 1 < nx_ && f[i] != f[i + 1];
                 ids[3 * i] = cx ? id : kNoVertex;
                 id += cx;
@@ -285,6 +309,26 @@ private:
         return ids;
     }
 
+    /// The tiling of crossed cell (i, j, k) with case code `code`, and its subcase. Cells with a
+    /// face or interior test are decided here, in pass 1 and again in pass 4 (the same exact
+    /// predicates on the same values, so the same answer): that costs less than storing a
+    /// decision per cell, and leaves no per-cell working memory.
+    const detail::Tiling& tiling_of(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, int& subcase) const
+    {
+        const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
+        if (!needs_values_[code]) {
+            subcase = first.subcase;
+            return first.tilings[0];
+        }
+        double v[8];
+        for (int c = 0; c < 8; ++c) {
+            v[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2])) - iso_;
+        }
+        const detail::Decision d = detail::decide(v, code, opt_.method);
+        subcase = d.subcase;
+        return d.variant->tilings[d.tiling];
+    }
+
     void count_row(std::int64_t j, std::int64_t k, Scratch& s, ExtractStats& stats)
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
@@ -296,44 +340,37 @@ private:
         if (k + 1 < nz_) flags(j, k + 1, s, n2);
         if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
         if ((n0 == 0 || n0 == nx_) && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
+        const auto r = static_cast<std::size_t>(row_index(j, k));
+        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
         std::int64_t vertices = 0, triangles = 0;
-        for (std::int64_t i = 0; i + 1 < nx_; ++i) vertices += f[i] != f[i + 1];
-        if (j + 1 < ny_) {
-            const std::uint8_t* fy = flags(j + 1, k, s);
-            for (std::int64_t i = 0; i < nx_; ++i) vertices += f[i] != fy[i];
+        std::int64_t lo = nx_, hi = 0;
+        for (std::int64_t i = 0; i < nx_; ++i) {
+            const int crossed = (i + 1 < nx_ && f[i] != f[i + 1]) + (f[i] != fy[i]) + (f[i] != fz[i]);
+            if (crossed != 0) {
+                vertices += crossed;
+                lo = std::min(lo, i);
+                hi = i + 1;
+            }
         }
-        if (k + 1 < nz_) {
-            const std::uint8_t* fz = flags(j, k + 1, s);
-            for (std::int64_t i = 0; i < nx_; ++i) vertices += f[i] != fz[i];
-        }
+        if (vertices > 0) edges_[r] = {lo, hi};
         if (j + 1 < ny_ && k + 1 < nz_) {
             column_codes(j, k, s);
             const std::uint8_t* col = s.columns.data();
+            lo = nx_;
+            hi = 0;
             for (std::int64_t i = 0; i + 1 < nx_; ++i) {
                 const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
                 if (code == 0 || code == 255) continue;
-                const detail::Variant* variant = &detail::kVariants[detail::kVariantOffset[code]];
-                unsigned tiling = 0;
-                int subcase = variant->subcase;
-                decisions_[cell_index(i, j, k)] = 0;
-                if (needs_values_[code]) {
-                    double v[8];
-                    for (int c = 0; c < 8; ++c) {
-                        v[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1],
-                                                      k + kCornerOffset[c][2])) - iso_;
-                    }
-                    const detail::Decision d = detail::decide(v, code, opt_.method);
-                    decisions_[cell_index(i, j, k)] = static_cast<std::uint8_t>(
-                        (d.variant - variant) | d.tiling << 6);
-                    variant = d.variant;
-                    tiling = static_cast<unsigned>(d.tiling);
-                    subcase = d.subcase;
-                }
-                const detail::Tiling& tl = variant->tilings[tiling];
+                int subcase = 0;
+                const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
                 vertices += tl.interior_count;
                 triangles += tl.triangle_count;
                 ++stats.cells_per_subcase[static_cast<std::size_t>(subcase)];
+                lo = std::min(lo, i);
+                hi = i + 1;
             }
+            if (hi > lo) cells_[r] = {lo, hi};
         }
         row_vertices_[static_cast<std::size_t>(row_index(j, k)) + 1] = vertices;
         row_triangles_[static_cast<std::size_t>(row_index(j, k)) + 1] = triangles;
@@ -364,7 +401,8 @@ private:
 
     void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Mesh& mesh) const
     {
-        for (std::int64_t slot = 0; slot < 3 * nx_; ++slot) {
+        const auto r = static_cast<std::size_t>(row_index(j, k));
+        for (std::int64_t slot = 3 * edges_[r][0]; slot < 3 * edges_[r][1]; ++slot) {
             const std::uint32_t id = ids[slot];
             if (id == kNoVertex) continue;
             const std::int64_t i = slot / 3;
@@ -400,13 +438,13 @@ private:
                                        row_ids(j, k + 1, s, unused), row_ids(j + 1, k + 1, s, unused)};
         column_codes(j, k, s);
         const std::uint8_t* col = s.columns.data();
-        std::int64_t tri = row_triangles_[static_cast<std::size_t>(row_index(j, k))];
-        for (std::int64_t i = 0; i + 1 < nx_; ++i) {
+        const auto r = static_cast<std::size_t>(row_index(j, k));
+        std::int64_t tri = row_triangles_[r];
+        for (std::int64_t i = cells_[r][0]; i < cells_[r][1]; ++i) {
             const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
             if (code == 0 || code == 255) continue;
-            const std::uint8_t dec = decisions_[cell_index(i, j, k)];
-            const detail::Variant& var = detail::kVariants[detail::kVariantOffset[code] + (dec & 63u)];
-            const detail::Tiling& tl = var.tilings[dec >> 6];
+            int subcase = 0;
+            const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
             std::uint32_t edge_id[12];
             for (int e = 0; e < 12; ++e) {
                 const int c = kEdgeCorners[e][0];
@@ -465,7 +503,9 @@ private:
     int threads_;
     std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
-    std::unique_ptr<std::uint8_t[]> decisions_;
+    /// Trim ranges from pass 1, per row: [edges_[r][0], edges_[r][1]) holds every sample of row r
+    /// that owns a crossed edge, [cells_[r][0], cells_[r][1]) every crossed cell of cell row r.
+    std::vector<std::array<std::int64_t, 2>> edges_, cells_;
 };
 
 template <class T> void validate(const GridView<T>& g, double iso)
