@@ -2,15 +2,57 @@
 /// @file mesh.hpp
 /// An indexed triangle mesh: a vertex is shared by every triangle that uses it.
 
+#include <cstddef>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace cmc33 {
 
+namespace detail {
+/// Memory for Buffer: large blocks (4 MiB and more) are 2 MiB aligned and marked for transparent
+/// huge pages, so that filling a big mesh takes hundreds of times fewer page faults.
+/// @throws std::bad_alloc
+void* allocate_buffer(std::size_t bytes);
+void deallocate_buffer(void* p, std::size_t bytes) noexcept;
+} // namespace detail
+
+/// std::allocator, except that resize(n) leaves new elements default-initialised (for float and
+/// integers: not written) instead of zeroing them. The extractor sizes a mesh once and writes every
+/// element in parallel; zeroing it first would be a second, single-threaded pass over the output.
+template <class T> struct DefaultInitAllocator : std::allocator<T> {
+    template <class U> struct rebind {
+        using other = DefaultInitAllocator<U>;
+    };
+    DefaultInitAllocator() noexcept = default;
+    template <class U> DefaultInitAllocator(const DefaultInitAllocator<U>&) noexcept {}
+    T* allocate(std::size_t n)
+    {
+        if (n > static_cast<std::size_t>(-1) / sizeof(T)) throw std::bad_array_new_length();
+        return static_cast<T*>(detail::allocate_buffer(n * sizeof(T)));
+    }
+    void deallocate(T* p, std::size_t n) noexcept { detail::deallocate_buffer(p, n * sizeof(T)); }
+    template <class U> void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>)
+    {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <class U, class... Args> void construct(U* p, Args&&... args)
+    {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
+
+/// A vector whose resize() does not zero new elements (see DefaultInitAllocator).
+template <class T> using Buffer = std::vector<T, DefaultInitAllocator<T>>;
+
+
 struct Mesh {
-    std::vector<float> positions;        ///< 3 per vertex, world coordinates
-    std::vector<float> normals;          ///< empty, or 3 per vertex (unit length)
-    std::vector<std::uint32_t> triangles; ///< 3 vertex indices per triangle, counter-clockwise
+    Buffer<float> positions;        ///< 3 per vertex, world coordinates
+    Buffer<float> normals;          ///< empty, or 3 per vertex (unit length)
+    Buffer<std::uint32_t> triangles; ///< 3 vertex indices per triangle, counter-clockwise
                                          ///< seen from the side the normal points to
 
     std::size_t vertex_count() const noexcept { return positions.size() / 3; }

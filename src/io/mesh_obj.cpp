@@ -29,7 +29,7 @@ struct ObjReader {
     const std::string& name;
     TextCursor in;
     Mesh mesh;
-    std::vector<float> file_normals;      // the vn list
+    Buffer<float> file_normals;           // the vn list
     std::vector<std::uint32_t> normal_of; // per vertex: vn index, or kNoNormal
     bool normals_consistent = true;
     std::vector<std::uint32_t> polygon;
@@ -39,7 +39,7 @@ struct ObjReader {
         throw Error(status, concat(name, ": line ", in.line(), ": ", what));
     }
 
-    void read_vector(std::vector<float>& out, std::string_view keyword)
+    void read_vector(Buffer<float>& out, std::string_view keyword)
     {
         std::string_view token;
         for (int k = 0; k < 3; ++k) {
@@ -137,7 +137,7 @@ struct ObjReader {
         if (!normals_consistent || file_normals.empty()) return;
         const std::size_t n = mesh.vertex_count();
         const std::size_t file_count = file_normals.size() / 3;
-        std::vector<float> normals(3 * n);
+        Buffer<float> normals(3 * n); // every element is written below, or it is dropped
         for (std::size_t v = 0; v < n; ++v) {
             // A vertex no face uses keeps the normal of the same rank, if there is one.
             std::size_t source = v < normal_of.size() ? normal_of[v] : kNoNormal;

@@ -60,7 +60,7 @@ bool is_degenerate(std::uint32_t a, std::uint32_t b, std::uint32_t c)
 
 MeshTopology mesh_topology(const Mesh& mesh)
 {
-    const std::vector<std::uint32_t>& tri = mesh.triangles;
+    const auto& tri = mesh.triangles;
     if (tri.size() % 3 != 0) {
         throw Error(Status::invalid_argument, "mesh_topology: the triangle array holds " +
                                                   std::to_string(tri.size()) +

@@ -85,7 +85,7 @@ TEST(Extract, NormalsPointFromAboveToBelow)
     // and triangles wind counter-clockwise around those normals
     double agree = 0;
     for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-        const auto at = [&](const std::vector<float>& xs, std::size_t corner, int k) {
+        const auto at = [&](const cmc33::Buffer<float>& xs, std::size_t corner, int k) {
             return static_cast<double>(xs[3 * mesh.triangles[3 * t + corner] + static_cast<std::size_t>(k)]);
         };
         double u[3], w[3], n[3];

@@ -26,8 +26,8 @@ using cmc33::Mesh;
 using cmc33::Status;
 namespace detail = cmc33::io::detail;
 
-using Indices = std::vector<std::uint32_t>;
-using Floats = std::vector<float>;
+using Indices = cmc33::Buffer<std::uint32_t>;
+using Floats = cmc33::Buffer<float>;
 
 // Reads `bytes` from a heap buffer of exactly that size (ASan then sees any over-read).
 Mesh read_bytes(const std::string& bytes, const std::string& name)
