@@ -173,8 +173,7 @@ public:
         const std::int64_t rows = ny_ * nz_;
         row_vertices_.assign(static_cast<std::size_t>(rows) + 1, 0);
         row_triangles_.assign(static_cast<std::size_t>(rows) + 1, 0);
-        edges_.assign(static_cast<std::size_t>(rows), {0, 0});
-        cells_.assign(static_cast<std::size_t>(rows), {0, 0});
+        range_.assign(static_cast<std::size_t>(rows), {0, 0});
         std::vector<ExtractStats> per_thread(static_cast<std::size_t>(threads_));
 
         // Pass 1: classify, decide, count.
@@ -292,7 +291,7 @@ private:
             const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
             auto id = static_cast<std::uint32_t>(row_vertices_[r]);
             // outside the range no edge crosses: those slots are never read for a vertex
-            for (std::int64_t i = edges_[r][0]; i < edges_[r][1]; ++i) {
+            for (std::int64_t i = range_[r][0]; i < range_[r][1]; ++i) {
                 const bool cx = i + 1 < nx_ && f[i] != f[i + 1];
                 ids[3 * i] = cx ? id : kNoVertex;
                 id += cx;
@@ -353,12 +352,9 @@ private:
                 hi = i + 1;
             }
         }
-        if (vertices > 0) edges_[r] = {lo, hi};
         if (j + 1 < ny_ && k + 1 < nz_) {
             column_codes(j, k, s);
             const std::uint8_t* col = s.columns.data();
-            lo = nx_;
-            hi = 0;
             for (std::int64_t i = 0; i + 1 < nx_; ++i) {
                 const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
                 if (code == 0 || code == 255) continue;
@@ -368,10 +364,10 @@ private:
                 triangles += tl.triangle_count;
                 ++stats.cells_per_subcase[static_cast<std::size_t>(subcase)];
                 lo = std::min(lo, i);
-                hi = i + 1;
+                hi = std::max(hi, i + 1);
             }
-            if (hi > lo) cells_[r] = {lo, hi};
         }
+        if (hi > lo) range_[r] = {static_cast<std::int32_t>(lo), static_cast<std::int32_t>(hi)};
         row_vertices_[static_cast<std::size_t>(row_index(j, k)) + 1] = vertices;
         row_triangles_[static_cast<std::size_t>(row_index(j, k)) + 1] = triangles;
     }
@@ -402,7 +398,7 @@ private:
     void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Mesh& mesh) const
     {
         const auto r = static_cast<std::size_t>(row_index(j, k));
-        for (std::int64_t slot = 3 * edges_[r][0]; slot < 3 * edges_[r][1]; ++slot) {
+        for (std::int64_t slot = 3 * std::int64_t{range_[r][0]}; slot < 3 * std::int64_t{range_[r][1]}; ++slot) {
             const std::uint32_t id = ids[slot];
             if (id == kNoVertex) continue;
             const std::int64_t i = slot / 3;
@@ -440,7 +436,8 @@ private:
         const std::uint8_t* col = s.columns.data();
         const auto r = static_cast<std::size_t>(row_index(j, k));
         std::int64_t tri = row_triangles_[r];
-        for (std::int64_t i = cells_[r][0]; i < cells_[r][1]; ++i) {
+        const std::int64_t last = std::min<std::int64_t>(range_[r][1], nx_ - 1);
+        for (std::int64_t i = range_[r][0]; i < last; ++i) {
             const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
             if (code == 0 || code == 255) continue;
             int subcase = 0;
@@ -503,9 +500,9 @@ private:
     int threads_;
     std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
-    /// Trim ranges from pass 1, per row: [edges_[r][0], edges_[r][1]) holds every sample of row r
-    /// that owns a crossed edge, [cells_[r][0], cells_[r][1]) every crossed cell of cell row r.
-    std::vector<std::array<std::int64_t, 2>> edges_, cells_;
+    /// Trim range from pass 1, per row r: [range_[r][0], range_[r][1]) holds every sample of row r
+    /// that owns a crossed edge and every crossed cell of cell row r (nx < 2^31: validate()).
+    std::vector<std::array<std::int32_t, 2>> range_;
 };
 
 template <class T> void validate(const GridView<T>& g, double iso)
@@ -521,6 +518,10 @@ template <class T> void validate(const GridView<T>& g, double iso)
         }
     }
     if (g.strides[0] != 1) throw Error(Status::invalid_argument, "grid view must have unit x-stride");
+    if (g.nx() > std::numeric_limits<std::int32_t>::max()) {
+        throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) +
+                                           " samples along x; the extractor handles at most 2^31 - 1 per row");
+    }
     if constexpr (std::is_floating_point_v<T>) {
         std::int64_t count = 0;
         Index3 first{-1, -1, -1};
