@@ -4,7 +4,7 @@
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 set -euo pipefail
 
-packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgtest-dev libgmock-dev
+packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3)
 if [[ "${1:-}" == "--bench" ]]; then
     packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time)

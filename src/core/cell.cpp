@@ -27,7 +27,7 @@ CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method 
     report.base_case = detail::kBaseCase[config];
     if (config == 0 || config == 255) return report;
 
-    const detail::Decision d = detail::decide(v, config, method, &report);
+    const detail::Decision d = detail::decide(values.data(), iso, config, method, &report);
     report.subcase = d.subcase;
     const detail::Tiling& tl = d.variant->tilings[d.tiling];
     // Crossing positions in the unit cube; interior vertices are means of crossings, as in extract().

@@ -4,6 +4,14 @@
 //
 // Values are differences to iso. The sign rule (design.md): a value >= 0 is above. It applies to
 // samples, face saddles and the saddles of the sweeping slices alike.
+//
+// Every decision is the sign of a polynomial (degree <= 6) in the eight values. It is computed
+// exactly: first in double arithmetic with a running error bound (Filtered); when a sign is within
+// its bound (a tie, or a near-tie such as decimal data whose exact sum is 0 but rounds to 1e-17),
+// the cell is decided again in exact rational arithmetic (GMP's mpq_class) on the same doubles.
+// So the extractor and the verifier, which decides exactly too, see the same field.
+
+#include <gmpxx.h>
 
 #include <cmath>
 #include <limits>
@@ -17,30 +25,85 @@ namespace cmc33::detail {
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+/// Thrown by a Filtered sign that rounding cannot settle; decide() then starts over exactly.
+struct Uncertain {};
+
+/// A double and a bound on its distance to the exact value of the same expression. Each operation
+/// adds its own rounding (relative 2^-50, a few times the unit roundoff, so that rounding in the
+/// bound's own arithmetic is covered) and, for products, the smallest subnormal (underflow).
+/// Overflow gives inf or NaN, whose sign is never trusted.
+struct Filtered {
+    double v = 0, e = 0;
+    Filtered() = default;
+    Filtered(double x) : v(x) {} // NOLINT: exact conversion
+    Filtered(double x, double err) : v(x), e(err) {}
+    static constexpr double kRel = 0x1p-50;
+    friend Filtered operator+(Filtered a, Filtered b)
+    {
+        const double s = a.v + b.v;
+        return {s, a.e + b.e + std::abs(s) * kRel};
+    }
+    friend Filtered operator-(Filtered a, Filtered b)
+    {
+        const double s = a.v - b.v;
+        return {s, a.e + b.e + std::abs(s) * kRel};
+    }
+    friend Filtered operator*(Filtered a, Filtered b)
+    {
+        const double p = a.v * b.v;
+        return {p, std::abs(a.v) * b.e + std::abs(b.v) * a.e + a.e * b.e + std::abs(p) * kRel +
+                       std::numeric_limits<double>::denorm_min()};
+    }
+};
+
+inline int sgn(double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; }
+inline int sgn(const Filtered& f)
+{
+    if (f.v > f.e) return 1;
+    if (-f.v > f.e) return -1;
+    if (f.v == 0 && f.e == 0) return 0;
+    throw Uncertain{};
+}
+inline int sgn(const mpq_class& q) { return mpq_sgn(q.get_mpq_t()); }
+
 /// Asymptotic decider (Nielson and Hamann 1991; Custodio et al. 2013, Eqs. 1-2) on an ambiguous
 /// face: are its above corners joined? With A, C one diagonal and B, D the other, the saddle value
 /// is (AC - BD) / (A + C - B - D); the denominator's sign is that of the above diagonal, so only the
 /// numerator's sign is needed, and a saddle equal to iso counts as above.
-inline bool face_joined(const double* v, int f, double* saddle = nullptr)
+template <class R> bool face_joined(const R* v, bool a_above, int f)
+{
+    const auto p = face_cycle(f);
+    const R& A = v[p[0]];
+    const R& B = v[p[1]];
+    const R& C = v[p[2]];
+    const R& D = v[p[3]];
+    const int num = sgn(A * C - B * D);
+    return a_above ? num >= 0 : num <= 0;
+}
+
+/// The face saddle's value minus iso, for reports (rounded; the decision does not use it).
+inline double face_saddle(const double* v, int f)
 {
     const auto p = face_cycle(f);
     const double A = v[p[0]], B = v[p[1]], C = v[p[2]], D = v[p[3]];
-    const double num = A * C - B * D;
-    if (saddle) *saddle = num / (A + C - B - D);
-    return A >= 0 ? num >= 0 : num <= 0;
+    return (A * C - B * D) / (A + C - B - D);
 }
 
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
 /// run on these with every value v - iso given as (v - iso) + eps: that is the level set at
 /// iso - eps, exactly the sign rule, so exact ties (integer data at an integer isovalue) are decided
 /// as the verifier sees them. Products drop eps^2: F's eps^2 terms cancel, and t_max is linear in eps.
-struct Eps {
-    double x = 0, y = 0;
-    friend Eps operator+(Eps a, Eps b) { return {a.x + b.x, a.y + b.y}; }
-    friend Eps operator-(Eps a, Eps b) { return {a.x - b.x, a.y - b.y}; }
-    friend Eps operator*(Eps a, Eps b) { return {a.x * b.x, a.x * b.y + a.y * b.x}; }
-    friend Eps operator*(double k, Eps a) { return {k * a.x, k * a.y}; }
-    int sign() const { return x > 0 ? 1 : x < 0 ? -1 : y > 0 ? 1 : y < 0 ? -1 : 0; }
+template <class R> struct EpsT {
+    R x{}, y{};
+    friend EpsT operator+(const EpsT& a, const EpsT& b) { return {a.x + b.x, a.y + b.y}; }
+    friend EpsT operator-(const EpsT& a, const EpsT& b) { return {a.x - b.x, a.y - b.y}; }
+    friend EpsT operator*(const EpsT& a, const EpsT& b) { return {a.x * b.x, a.x * b.y + a.y * b.x}; }
+    friend EpsT operator*(double k, const EpsT& a) { return {R(k) * a.x, R(k) * a.y}; }
+    int sign() const
+    {
+        const int s = sgn(x);
+        return s != 0 ? s : sgn(y);
+    }
     bool above() const { return sign() >= 0; } // the sign rule: zero counts as above
 };
 
@@ -66,19 +129,16 @@ template <class Num> struct SweepT {
     Num den(Num t) const { return at(A0, A1, t) + at(C0, C1, t) - at(B0, B1, t) - at(D0, D1, t); }
 };
 using Sweep = SweepT<double>;
-using SweepEps = SweepT<Eps>;
-
-inline int sign_of(double v) { return v > 0 ? 1 : v < 0 ? -1 : 0; }
-inline int sign_of(const Eps& v) { return v.sign(); }
 
 /// In the slice at height t, is the region of corner A joined to that of corner C? Both must have
 /// A0's sign; through B or D when one of them has it too, else by the slice's saddle (asymptotic
 /// decider; a saddle equal to iso is above).
-inline bool slice_joins(const SweepEps& s, Eps t)
+template <class R> bool slice_joins(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
 {
+    using S = SweepT<EpsT<R>>;
     const bool above = s.A0.above();
-    const Eps a_t = SweepEps::at(s.A0, s.A1, t), b_t = SweepEps::at(s.B0, s.B1, t);
-    const Eps c_t = SweepEps::at(s.C0, s.C1, t), d_t = SweepEps::at(s.D0, s.D1, t);
+    const EpsT<R> a_t = S::at(s.A0, s.A1, t), b_t = S::at(s.B0, s.B1, t);
+    const EpsT<R> c_t = S::at(s.C0, s.C1, t), d_t = S::at(s.D0, s.D1, t);
     if (a_t.above() != above || c_t.above() != above) return false;
     if (b_t.above() == above || d_t.above() == above) return true;
     const int num = (a_t * c_t - b_t * d_t).sign();
@@ -86,15 +146,16 @@ inline bool slice_joins(const SweepEps& s, Eps t)
 }
 
 /// Is the slice saddle at t (Custodio et al., Eq. 9: u along A->B, v along A->D) inside the face?
-inline bool saddle_inside(const SweepEps& s, Eps t)
+template <class R> bool saddle_inside(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
 {
-    const Eps a_t = SweepEps::at(s.A0, s.A1, t), b_t = SweepEps::at(s.B0, s.B1, t);
-    const Eps d_t = SweepEps::at(s.D0, s.D1, t);
-    const Eps den = s.den(t);
+    using S = SweepT<EpsT<R>>;
+    const EpsT<R> a_t = S::at(s.A0, s.A1, t), b_t = S::at(s.B0, s.B1, t);
+    const EpsT<R> d_t = S::at(s.D0, s.D1, t);
+    const EpsT<R> den = s.den(t);
     const int sd = den.sign();
     if (sd == 0) return false;
     // 0 < n / den < 1  <=>  n and den - n both have den's sign
-    const Eps nu = a_t - d_t, nv = a_t - b_t;
+    const EpsT<R> nu = a_t - d_t, nv = a_t - b_t;
     return nu.sign() == sd && (den - nu).sign() == sd && nv.sign() == sd && (den - nv).sign() == sd;
 }
 
@@ -104,29 +165,30 @@ inline bool saddle_inside(const SweepEps& s, Eps t)
 /// Nothing is divided: with a < 0, sign(X(t_max)) = sign((X1 - X0) b - 2a X0) and
 /// F(t_max) = (4ac - b^2) / 4a has the sign of b^2 - 4ac. On data with exact ties (integers,
 /// dyadic fractions) these are exact, so a zero is a true zero and the eps terms decide it.
-inline bool chernyaev_joined(const SweepEps& s)
+template <class R> bool chernyaev_joined(const SweepT<EpsT<R>>& s)
 {
-    const Eps a = s.a(), b = s.b(), c = s.c(); // a carries no eps: it is made of differences
-    if (!(a.x < 0)) return false;
+    using E = EpsT<R>;
+    const E a = s.a(), b = s.b(), c = s.c(); // a carries no eps: it is made of differences
+    if (sgn(a.x) >= 0) return false;
     if (b.sign() <= 0 || (2.0 * a + b).sign() >= 0) return false; // t_max outside (0, 1)
-    const Eps two_a = 2.0 * a;
-    const auto above_at_max = [&](Eps x0, Eps x1) { return ((x1 - x0) * b - two_a * x0).above(); };
+    const E two_a = 2.0 * a;
+    const auto above_at_max = [&](const E& x0, const E& x1) { return ((x1 - x0) * b - two_a * x0).above(); };
     const bool joined_sign = s.A0.above();
     if (above_at_max(s.A0, s.A1) != joined_sign || above_at_max(s.C0, s.C1) != joined_sign) return false;
     if (above_at_max(s.B0, s.B1) == joined_sign || above_at_max(s.D0, s.D1) == joined_sign) return true;
     // F(t_max): b^2 - 4ac to first order in eps, and its eps^2 term b.y^2 when both vanish
-    const Eps g = b * b - 4.0 * (a * c);
-    const int f = g.sign() != 0 ? g.sign() : (b.y != 0 ? 1 : 0);
+    const E g = b * b - 4.0 * (a * c);
+    const int f = g.sign() != 0 ? g.sign() : (sgn(b.y) != 0 ? 1 : 0);
     return joined_sign ? f >= 0 : f > 0;
 }
 
 /// Sign of P + Q sqrt(D), D >= 0, without rounding a square root: compare P^2 with Q^2 D. When
 /// D is an infinitesimal eps * D.y, sqrt(D) ~ sqrt(eps) outweighs any eps term.
-inline int sign_p_plus_q_sqrt(Eps P, Eps Q, Eps D)
+template <class R> int sign_p_plus_q_sqrt(const EpsT<R>& P, const EpsT<R>& Q, const EpsT<R>& D)
 {
-    if (D.x == 0) {
-        if (P.x != 0) return P.x > 0 ? 1 : -1;
-        if (Q.x != 0 && D.y > 0) return Q.x > 0 ? 1 : -1;
+    if (sgn(D.x) == 0) {
+        if (sgn(P.x) != 0) return sgn(P.x);
+        if (sgn(Q.x) != 0 && sgn(D.y) > 0) return sgn(Q.x);
         return P.sign() != 0 ? P.sign() : Q.sign();
     }
     const int sp = P.sign(), sq = Q.sign();
@@ -137,11 +199,12 @@ inline int sign_p_plus_q_sqrt(Eps P, Eps Q, Eps D)
 }
 
 /// Sign of l0 + l1 t at the root t = (-b + sigma sqrt(disc)) / 2a of F (a != 0).
-inline int sign_at_root(Eps l0, Eps l1, Eps a, Eps b, Eps disc, int sigma)
+template <class R>
+int sign_at_root(const EpsT<R>& l0, const EpsT<R>& l1, const EpsT<R>& a, const EpsT<R>& b, const EpsT<R>& disc, int sigma)
 {
-    const Eps P = 2.0 * (a * l0) - l1 * b;
-    const Eps Q = static_cast<double>(sigma) * l1;
-    return sign_p_plus_q_sqrt(P, Q, disc) * (a.x > 0 ? 1 : -1);
+    const EpsT<R> P = 2.0 * (a * l0) - l1 * b;
+    const EpsT<R> Q = static_cast<double>(sigma) * l1;
+    return sign_p_plus_q_sqrt(P, Q, disc) * (sgn(a.x) > 0 ? 1 : -1);
 }
 
 /// Algorithm 1 (Custodio et al. 2013, Sec. 6.1): 13.5.2 iff both roots t1, t2 of F lie in (0, 1)
@@ -149,16 +212,17 @@ inline int sign_at_root(Eps l0, Eps l1, Eps a, Eps b, Eps disc, int sigma)
 /// the sign (+1, -1) of the slice saddle at (t1 + t2) / 2: the tunnel faces the isolated corner of
 /// that sign (Sec. 6.1.1). Every quantity is linear in t and is evaluated at the roots exactly
 /// (sign_at_root), so ties in the data cannot be decided by rounding.
-inline int algorithm1(const SweepEps& s)
+template <class R> int algorithm1(const SweepT<EpsT<R>>& s)
 {
-    const Eps a = s.a(), b = s.b(), c = s.c();
-    if (a.x == 0) return 0; // F is at most linear: one root
-    const Eps disc = b * b - 4.0 * (a * c);
+    using E = EpsT<R>;
+    const E a = s.a(), b = s.b(), c = s.c();
+    if (sgn(a.x) == 0) return 0; // F is at most linear: one root
+    const E disc = b * b - 4.0 * (a * c);
     if (disc.sign() <= 0) return 0; // no real roots, or a double root even below iso
-    const Eps one{1, 0}, zero{0, 0};
-    const Eps dA = s.A1 - s.A0, dB = s.B1 - s.B0, dC = s.C1 - s.C0, dD = s.D1 - s.D0;
+    const E one{R(1), R(0)}, zero{R(0), R(0)};
+    const E dA = s.A1 - s.A0, dB = s.B1 - s.B0, dC = s.C1 - s.C0, dD = s.D1 - s.D0;
     for (int sigma : {-1, 1}) {
-        const auto sg = [&](Eps l0, Eps l1) { return sign_at_root(l0, l1, a, b, disc, sigma); };
+        const auto sg = [&](const E& l0, const E& l1) { return sign_at_root(l0, l1, a, b, disc, sigma); };
         if (sg(zero, one) <= 0 || sg(one, zero - one) <= 0) return 0; // root in (0, 1)
         // saddle (u, v) = (A - D, A - B) / den inside: A - D, C - B, A - B, C - D all of den's sign
         const int sd = sg(s.A0 + s.C0 - s.B0 - s.D0, dA + dC - dB - dD);
@@ -168,9 +232,9 @@ inline int algorithm1(const SweepEps& s)
         }
     }
     // At the midpoint t = -b / 2a: F = -disc / 4a, and den's sign from 2a den0 - den1 b.
-    const int f_sign = -(a.x > 0 ? 1 : -1);
-    const Eps den0 = s.A0 + s.C0 - s.B0 - s.D0, den1 = dA + dC - dB - dD;
-    const int den_sign = (2.0 * (a * den0) - den1 * b).sign() * (a.x > 0 ? 1 : -1);
+    const int f_sign = -(sgn(a.x) > 0 ? 1 : -1);
+    const E den0 = s.A0 + s.C0 - s.B0 - s.D0, den1 = dA + dC - dB - dD;
+    const int den_sign = (2.0 * (a * den0) - den1 * b).sign() * (sgn(a.x) > 0 ? 1 : -1);
     return f_sign * den_sign >= 0 ? 1 : -1;
 }
 
@@ -217,18 +281,23 @@ struct Decision {
     int subcase;
 };
 
-/// Decides one cell with `config` not 0 or 255.
-inline Decision decide(const double* v, unsigned config, Method method, CellReport* report = nullptr)
+/// decide() in the number type R (Filtered: may throw Uncertain; mpq_class: exact). `raw` are the
+/// corner samples, `v` the same minus iso rounded to double (for reports and mc33-lewiner's t_alt);
+/// the decisions use raw - iso computed in R.
+template <class R>
+Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method, CellReport* report)
 {
+    using E = EpsT<R>;
+    R w[8];
+    for (int q = 0; q < 8; ++q) w[q] = R(raw[q]) - R(iso);
     const unsigned amb = kAmbiguousFaces[config];
     unsigned bits = 0;
     if (method != Method::mc) {
         int i = 0;
         for (int f = 0; f < 6; ++f) {
             if (!((amb >> f) & 1u)) continue;
-            double saddle = 0;
-            if (face_joined(v, f, report ? &saddle : nullptr)) bits |= 1u << i;
-            if (report) report->faces[f] = {true, saddle, ((bits >> i) & 1u) != 0, true};
+            if (face_joined<R>(w, v[face_cycle(f)[0]] >= 0, f)) bits |= 1u << i;
+            if (report) report->faces[f] = {true, face_saddle(v, f), ((bits >> i) & 1u) != 0, true};
             ++i;
         }
     } else if (report) {
@@ -241,9 +310,9 @@ inline Decision decide(const double* v, unsigned config, Method method, CellRepo
     if (var->test == kTestNone || method == Method::mc) return d;
 
     InteriorReport* r = report ? &report->interior : nullptr;
-    Eps ve[8];
-    for (int q = 0; q < 8; ++q) ve[q] = {v[q], 1.0};
-    const SweepEps sweep(ve, var->axis, var->corner);
+    E ve[8];
+    for (int q = 0; q < 8; ++q) ve[q] = {w[q], R(1.0)};
+    const SweepT<E> sweep(ve, var->axis, var->corner);
     const Sweep lewiner(v, var->lewiner_axis, var->lewiner_corner);
     const double t_lewiner = t_alt(v, var->lewiner_edge);
     if (r) report_numbers(Sweep(v, var->axis, var->corner), lewiner, t_lewiner, *var, *r);
@@ -255,8 +324,8 @@ inline Decision decide(const double* v, unsigned config, Method method, CellRepo
             tunnel = chernyaev_joined(sweep);
         } else {
             // 6, 7, 12 in mc33-lewiner: the slice at Lewiner's t_alt instead of t_max
-            const SweepEps lw(ve, var->lewiner_axis, var->lewiner_corner);
-            tunnel = slice_joins(lw, Eps{t_lewiner, 0});
+            const SweepT<E> lw(ve, var->lewiner_axis, var->lewiner_corner);
+            tunnel = slice_joins(lw, E{R(t_lewiner), R(0.0)});
         }
         if (method == Method::mc33_lewiner && var->lewiner_skips) {
             tunnel = false; // cases 10 and 12 with both faces joined: never tested (Sec. 5.4)
@@ -278,6 +347,20 @@ inline Decision decide(const double* v, unsigned config, Method method, CellRepo
         r->tunnel_corner = tiling == 1 ? var->lewiner_corner : var->lewiner_corner ^ 7;
     }
     return {var, tiling, var->tunnel_subcase};
+}
+
+/// Decides one cell with `config` not 0 or 255: in filtered double arithmetic, and where rounding
+/// could change a sign, again exactly.
+/// `raw`: the eight corner samples (corner order of cube.hpp).
+inline Decision decide(const double* raw, double iso, unsigned config, Method method, CellReport* report = nullptr)
+{
+    double v[8];
+    for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+    try {
+        return decide_in<Filtered>(raw, iso, v, config, method, report);
+    } catch (const Uncertain&) {
+        return decide_in<mpq_class>(raw, iso, v, config, method, report);
+    }
 }
 
 } // namespace cmc33::detail

@@ -319,11 +319,11 @@ private:
             subcase = first.subcase;
             return first.tilings[0];
         }
-        double v[8];
+        double raw[8];
         for (int c = 0; c < 8; ++c) {
-            v[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2])) - iso_;
+            raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
-        const detail::Decision d = detail::decide(v, code, opt_.method);
+        const detail::Decision d = detail::decide(raw, iso_, code, opt_.method);
         subcase = d.subcase;
         return d.variant->tilings[d.tiling];
     }

@@ -250,3 +250,46 @@ TEST(Extract, RandomGridsMatchTheFieldTopology)
 }
 
 } // namespace
+
+namespace {
+
+/// The mesh of `v` at `iso` has the field's topology and is a manifold.
+::testing::AssertionResult matches_field(const Volume& v, double iso)
+{
+    const cmc33::Mesh mesh = cmc33::extract(v, iso);
+    const cmc33::MeshTopology t = cmc33::mesh_topology(mesh);
+    const cmc33::FieldTopology f = cmc33::field_topology(v, iso);
+    if (!f.determined) return ::testing::AssertionFailure() << "field undetermined: " << f.why;
+    if (t.nonmanifold_edges != 0 || t.nonmanifold_vertices != 0) return ::testing::AssertionFailure() << "non-manifold";
+    if (t.euler != f.euler || t.components != f.b0 || t.b1 != f.b1 || t.closed_components != f.b2 ||
+        t.boundary_loops != f.boundary_loops) {
+        return ::testing::AssertionFailure() << "mesh chi " << t.euler << " b0 " << t.components << " loops "
+                                             << t.boundary_loops << ", field chi " << f.euler << " b0 " << f.b0
+                                             << " loops " << f.boundary_loops;
+    }
+    return ::testing::AssertionSuccess();
+}
+
+} // namespace
+
+// Near-ties that rounding cannot settle: samples k/3, k/5, k/10 as doubles (an exact zero such as
+// 1/3 - 2/3 + 1/3 rounds to 1e-17), and float samples against an isovalue float cannot hold (0.1).
+// Every sign is decided exactly (filtered, then GMP), as the verifier decides it.
+TEST(Extract, DecimalNearTiesMatchTheFieldTopology)
+{
+    std::mt19937_64 rng(2026);
+    for (int den : {3, 5, 10}) {
+        std::uniform_int_distribution<int> pick(-den, den);
+        for (int g = 0; g < 400; ++g) {
+            Volume v(cmc33::ScalarType::f64, {5, 5, 5});
+            for (std::int64_t i = 0; i < v.sample_count(); ++i) v.samples<double>()[i] = pick(rng) / static_cast<double>(den);
+            ASSERT_TRUE(matches_field(v, 0.0)) << "den " << den << " grid " << g;
+        }
+    }
+    std::uniform_int_distribution<int> tenths(-5, 7);
+    for (int g = 0; g < 400; ++g) {
+        Volume v(cmc33::ScalarType::f32, {5, 5, 5});
+        for (std::int64_t i = 0; i < v.sample_count(); ++i) v.samples<float>()[i] = static_cast<float>(tenths(rng)) / 10.0f;
+        ASSERT_TRUE(matches_field(v, 0.1)) << "float grid " << g;
+    }
+}
