@@ -66,6 +66,29 @@ inline int sgn(const Filtered& f)
 }
 inline int sgn(const mpq_class& q) { return mpq_sgn(q.get_mpq_t()); }
 
+/// Exact for small integers: with |value - iso| <= 2^15 every polynomial of a decision stays below
+/// 2^111 (the largest, P^2 - Q^2 disc of Algorithm 1, is at most 2^14 * |v|^6), far inside 2^127.
+__extension__ typedef __int128 Int128;
+inline int sgn(Int128 x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+inline constexpr double kSmallInteger = 32768.0;
+
+/// 2^k (k <= 8) such that iso * 2^k and every sample * 2^k are integers with
+/// |sample - iso| * 2^k <= 2^15, or 0. Integer data at an integer or half-integer isovalue takes
+/// this exact path; scaling every value by 2^k changes no sign (the decisions are homogeneous).
+inline double small_integer_scale(const double* raw, double iso)
+{
+    for (double scale = 1; scale <= 256; scale *= 2) {
+        const double s_iso = iso * scale;
+        if (s_iso != std::floor(s_iso)) continue;
+        for (int q = 0; q < 8; ++q) {
+            const double x = raw[q] * scale;
+            if (x != std::floor(x) || std::abs(x - s_iso) > kSmallInteger) return 0;
+        }
+        return scale;
+    }
+    return 0;
+}
+
 /// Asymptotic decider (Nielson and Hamann 1991; Custodio et al. 2013, Eqs. 1-2) on an ambiguous
 /// face: are its above corners joined? With A, C one diagonal and B, D the other, the saddle value
 /// is (AC - BD) / (A + C - B - D); the denominator's sign is that of the above diagonal, so only the
@@ -351,11 +374,21 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
 
 /// Decides one cell with `config` not 0 or 255: in filtered double arithmetic, and where rounding
 /// could change a sign, again exactly.
-/// `raw`: the eight corner samples (corner order of cube.hpp).
-inline Decision decide(const double* raw, double iso, unsigned config, Method method, CellReport* report = nullptr)
+/// `raw`: the eight corner samples (corner order of cube.hpp). `integers`: try the 128-bit integer
+/// path first (the extractor passes true for integer sample types).
+inline Decision decide(const double* raw, double iso, unsigned config, Method method, CellReport* report = nullptr,
+                       bool integers = true)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+    // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
+    if (integers && method == Method::cmc33) {
+        if (const double scale = small_integer_scale(raw, iso); scale != 0) {
+            double scaled[8];
+            for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
+            return decide_in<Int128>(scaled, iso * scale, v, config, method, report);
+        }
+    }
     try {
         return decide_in<Filtered>(raw, iso, v, config, method, report);
     } catch (const Uncertain&) {

@@ -293,3 +293,24 @@ TEST(Extract, DecimalNearTiesMatchTheFieldTopology)
         ASSERT_TRUE(matches_field(v, 0.1)) << "float grid " << g;
     }
 }
+
+// Integer samples take an exact 128-bit path when |sample - iso| <= 2^15 (after scaling a
+// half-integer isovalue by 2), and the filtered path otherwise: both against the verifier, on
+// few distinct values (many exact ties) and on wide ones.
+TEST(Extract, IntegerDataMatchesTheFieldTopologyOnBothExactPaths)
+{
+    std::mt19937_64 rng(33);
+    std::uniform_int_distribution<int> narrow(77, 83), wide(-100000, 100000);
+    for (int g = 0; g < 300; ++g) {
+        Volume u8(cmc33::ScalarType::u8, {5, 5, 5});
+        Volume i32(cmc33::ScalarType::i32, {5, 5, 5});
+        for (std::int64_t i = 0; i < u8.sample_count(); ++i) {
+            u8.samples<std::uint8_t>()[i] = static_cast<std::uint8_t>(narrow(rng));
+            i32.samples<std::int32_t>()[i] = wide(rng);
+        }
+        ASSERT_TRUE(matches_field(u8, 80.0)) << "uint8 grid " << g;
+        ASSERT_TRUE(matches_field(u8, 80.5)) << "uint8 grid " << g << " at 80.5";
+        ASSERT_TRUE(matches_field(u8, 80.3)) << "uint8 grid " << g << " at 80.3";
+        ASSERT_TRUE(matches_field(i32, 0.0)) << "int32 grid " << g;
+    }
+}
