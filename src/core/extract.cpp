@@ -247,7 +247,7 @@ private:
         std::uint8_t* f = s.flags.get(j, k, fresh, count);
         if (fresh) {
             above_.row(g_.data + g_.offset(0, j, k), nx_, f);
-            std::int64_t n = 0;
+            std::uint32_t n = 0; // nx < 2^31 (validate); a narrow sum vectorises
             for (std::int64_t i = 0; i < nx_; ++i) n += f[i];
             *count = n;
         }
@@ -263,12 +263,13 @@ private:
     /// Column codes of cell row (j, k) into s.columns (see kCellCode).
     void column_codes(std::int64_t j, std::int64_t k, Scratch& s) const
     {
-        const std::uint8_t* f00 = flags(j, k, s);
-        const std::uint8_t* f10 = flags(j + 1, k, s);
-        const std::uint8_t* f01 = flags(j, k + 1, s);
-        const std::uint8_t* f11 = flags(j + 1, k + 1, s);
-        std::uint8_t* col = s.columns.data();
-        for (std::int64_t i = 0; i < nx_; ++i) {
+        const std::uint8_t* __restrict f00 = flags(j, k, s);
+        const std::uint8_t* __restrict f10 = flags(j + 1, k, s);
+        const std::uint8_t* __restrict f01 = flags(j, k + 1, s);
+        const std::uint8_t* __restrict f11 = flags(j + 1, k + 1, s);
+        std::uint8_t* __restrict col = s.columns.data();
+        const std::int64_t n = nx_; // a local bound: byte stores may alias members, which blocks vectorising
+        for (std::int64_t i = 0; i < n; ++i) {
             col[i] = static_cast<std::uint8_t>(f00[i] | f10[i] << 1 | f01[i] << 2 | f11[i] << 3);
         }
     }
@@ -342,15 +343,20 @@ private:
         const auto r = static_cast<std::size_t>(row_index(j, k));
         const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
-        std::int64_t vertices = 0, triangles = 0;
+        // crossed edges owned by the row: flags are 0 or 1, so != is ^ and the sum vectorises
+        std::uint32_t crossed = 0;
+        for (std::int64_t i = 0; i + 1 < nx_; ++i) crossed += static_cast<std::uint32_t>(f[i] ^ f[i + 1]);
+        for (std::int64_t i = 0; i < nx_; ++i) crossed += static_cast<std::uint32_t>((f[i] ^ fy[i]) + (f[i] ^ fz[i]));
+        std::int64_t vertices = crossed, triangles = 0;
         std::int64_t lo = nx_, hi = 0;
-        for (std::int64_t i = 0; i < nx_; ++i) {
-            const int crossed = (i + 1 < nx_ && f[i] != f[i + 1]) + (f[i] != fy[i]) + (f[i] != fz[i]);
-            if (crossed != 0) {
-                vertices += crossed;
-                lo = std::min(lo, i);
-                hi = i + 1;
-            }
+        if (crossed != 0) {
+            const auto owns = [&](std::int64_t i) {
+                return (i + 1 < nx_ && f[i] != f[i + 1]) || f[i] != fy[i] || f[i] != fz[i];
+            };
+            lo = 0;
+            while (!owns(lo)) ++lo;
+            hi = nx_;
+            while (!owns(hi - 1)) --hi;
         }
         if (j + 1 < ny_ && k + 1 < nz_) {
             column_codes(j, k, s);
