@@ -154,7 +154,8 @@ private:
         auto product = [&r](double x, double y, double& hi, double& lo) {
             hi = x * y;
             lo = std::fma(x, y, -hi);
-            if (!std::isfinite(hi) || (hi != 0.0 && std::fabs(hi) < 0x1p-969)) r.lost_ = true;
+            // x, y != 0 (zero-eliminated components, b != 0): a product that underflowed to 0 is lost too
+            if (!std::isfinite(hi) || std::fabs(hi) < 0x1p-969) r.lost_ = true;
         };
         double q = 0.0;
         double lo = 0.0;

@@ -314,3 +314,32 @@ TEST(Extract, IntegerDataMatchesTheFieldTopologyOnBothExactPaths)
         ASSERT_TRUE(matches_field(i32, 0.0)) << "int32 grid " << g;
     }
 }
+
+// Values so small that the verifier's products underflow (1e-100^4): the extractor's exact
+// decisions do not care about scale (same mesh topology as the grid scaled by 2^332), and the
+// verifier must either say "undetermined" or agree, never silently lose an underflowed product.
+TEST(Extract, TinyValuesAreDecidedLikeTheirRescaledGrid)
+{
+    std::mt19937_64 rng(5);
+    std::uniform_int_distribution<int> pick(-2, 2);
+    int determined = 0;
+    for (int g = 0; g < 300; ++g) {
+        Volume tiny(cmc33::ScalarType::f64, {5, 5, 5}), rescaled(cmc33::ScalarType::f64, {5, 5, 5});
+        for (std::int64_t i = 0; i < tiny.sample_count(); ++i) {
+            tiny.samples<double>()[i] = pick(rng) / 3.0 * 1e-100;
+            rescaled.samples<double>()[i] = std::ldexp(tiny.samples<double>()[i], 332);
+        }
+        ASSERT_TRUE(matches_field(rescaled, 0.0)) << "grid " << g;
+        const cmc33::MeshTopology a = cmc33::mesh_topology(cmc33::extract(tiny, 0.0));
+        const cmc33::MeshTopology b = cmc33::mesh_topology(cmc33::extract(rescaled, 0.0));
+        EXPECT_EQ(a.euler, b.euler);
+        EXPECT_EQ(a.components, b.components);
+        EXPECT_EQ(a.boundary_loops, b.boundary_loops);
+        const cmc33::FieldTopology f = cmc33::field_topology(tiny, 0.0);
+        if (f.determined) {
+            ++determined;
+            EXPECT_TRUE(matches_field(tiny, 0.0)) << "grid " << g;
+        }
+    }
+    RecordProperty("determined_tiny_grids", determined);
+}
