@@ -1,8 +1,6 @@
 // cmc33 verify: the topology stress test on random fields, or a check of a verification dataset
 // (in-process, or of any extractor run as a command). docs/verification.md explains both.
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -23,9 +21,6 @@
 namespace cmc33::cli {
 
 namespace {
-
-/// A progress line is drawn on the terminal without its newline yet.
-bool line_open = false;
 
 /// A run that found mismatches: main() prints the message and exits with status 1.
 class VerificationFailed : public std::runtime_error {
@@ -51,12 +46,6 @@ struct VerifyArgs {
 };
 
 constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed"};
-
-std::string rate_text(double per_second)
-{
-    return per_second >= 100 ? std::to_string(static_cast<std::int64_t>(per_second + 0.5))
-                             : sig(per_second, 3);
-}
 
 std::vector<Method> parse_methods(const std::vector<std::string>& names)
 {
@@ -296,44 +285,6 @@ void run_verify(const VerifyArgs& args, const std::string& failures_default)
 }
 
 } // namespace
-
-/// The progress line on stderr: rewritten in place about once a second when stderr is a
-/// terminal (or printed as lines when `forced` and it is not), and always a final line.
-ProgressCallback progress_line(bool forced, const std::string& what)
-{
-    line_open = false;
-    const bool tty = ::isatty(STDERR_FILENO) == 1;
-    struct State {
-        double last = -1;
-        bool finished = false;
-    };
-    auto state = std::make_shared<State>();
-    return [tty, forced, what, state](const VerifyProgress& p) {
-        if (state->finished) return;
-        const bool final = p.done == p.total;
-        if (!final && (!(tty || forced) || p.seconds - state->last < 1.0)) return;
-        state->last = p.seconds;
-        state->finished = final;
-        const double rate = p.seconds > 0 ? static_cast<double>(p.done) / p.seconds : 0.0;
-        std::string line = std::to_string(p.done) + "/" + std::to_string(p.total) + " " + what +
-                           ", " + rate_text(rate) + "/s, " + sig(p.seconds, 3) + " s";
-        if (p.mismatched != 0) line += ", " + std::to_string(p.mismatched) + " mismatched";
-        std::cout.flush();
-        if (tty) {
-            std::cerr << '\r' << line << "\x1b[K" << (final ? "\n" : "") << std::flush;
-            line_open = !final;
-        } else {
-            std::cerr << line << '\n' << std::flush;
-        }
-    };
-}
-
-/// Ends a half-drawn progress line, so that an error message that follows starts its own line.
-void end_progress_line()
-{
-    if (line_open) std::cerr << '\n';
-    line_open = false;
-}
 
 void add_verify(CLI::App& app)
 {

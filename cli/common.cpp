@@ -1,5 +1,7 @@
 #include "common.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -18,6 +21,9 @@ namespace cmc33::cli {
 namespace fs = std::filesystem;
 
 namespace {
+
+/// A progress line is drawn on the terminal without its newline yet.
+bool line_open = false;
 
 /// "N" must be a whole number >= 1 (CLI11's PositiveNumber prints DBL_MAX in its message).
 const CLI::Validator kPositiveInteger(
@@ -277,6 +283,50 @@ void rethrow_naming(const Error& error, const std::string& path)
     const std::string message = error.what();
     if (message.find(path) != std::string::npos) throw error;
     throw Error(error.status(), path + ": " + message);
+}
+
+std::string rate_text(double per_second)
+{
+    return per_second >= 100 ? std::to_string(static_cast<std::int64_t>(per_second + 0.5))
+                             : sig(per_second, 3);
+}
+
+/// The progress line on stderr: rewritten in place about once a second when stderr is a
+/// terminal (or printed as lines when `forced` and it is not), and always a final line.
+ProgressCallback progress_line(bool forced, const std::string& what)
+{
+    line_open = false;
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    struct State {
+        double last = -1;
+        bool finished = false;
+    };
+    auto state = std::make_shared<State>();
+    return [tty, forced, what, state](const VerifyProgress& p) {
+        if (state->finished) return;
+        const bool final = p.done == p.total;
+        if (!final && (!(tty || forced) || p.seconds - state->last < 1.0)) return;
+        state->last = p.seconds;
+        state->finished = final;
+        const double rate = p.seconds > 0 ? static_cast<double>(p.done) / p.seconds : 0.0;
+        std::string line = std::to_string(p.done) + "/" + std::to_string(p.total) + " " + what +
+                           ", " + rate_text(rate) + "/s, " + sig(p.seconds, 3) + " s";
+        if (p.mismatched != 0) line += ", " + std::to_string(p.mismatched) + " mismatched";
+        std::cout.flush();
+        if (tty) {
+            std::cerr << '\r' << line << "\x1b[K" << (final ? "\n" : "") << std::flush;
+            line_open = !final;
+        } else {
+            std::cerr << line << '\n' << std::flush;
+        }
+    };
+}
+
+/// Ends a half-drawn progress line, so that an error message that follows starts its own line.
+void end_progress_line()
+{
+    if (line_open) std::cerr << '\n';
+    line_open = false;
 }
 
 } // namespace cmc33::cli

@@ -77,7 +77,10 @@ void print_json(const Json& json);
 /// UsageError for --ascii with anything but .ply.
 void check_mesh_output(const std::string& output, bool ascii);
 
-/// The progress of verify and dataset on stderr (cmd_verify.cpp): redrawn in place on a terminal,
+/// "1234" for rates of 100 and more, else 3 significant digits.
+std::string rate_text(double per_second);
+
+/// The progress of verify and dataset on stderr: redrawn in place on a terminal,
 /// about once a second; when stderr is not a terminal, lines only if `forced`; always a final line.
 ProgressCallback progress_line(bool forced, const std::string& what);
 /// Ends a half-drawn progress line, so that an error message that follows starts its own line.

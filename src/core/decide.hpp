@@ -168,20 +168,6 @@ template <class R> bool slice_joins(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
     return above ? num >= 0 : num > 0;
 }
 
-/// Is the slice saddle at t (Custodio et al., Eq. 9: u along A->B, v along A->D) inside the face?
-template <class R> bool saddle_inside(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
-{
-    using S = SweepT<EpsT<R>>;
-    const EpsT<R> a_t = S::at(s.A0, s.A1, t), b_t = S::at(s.B0, s.B1, t);
-    const EpsT<R> d_t = S::at(s.D0, s.D1, t);
-    const EpsT<R> den = s.den(t);
-    const int sd = den.sign();
-    if (sd == 0) return false;
-    // 0 < n / den < 1  <=>  n and den - n both have den's sign
-    const EpsT<R> nu = a_t - d_t, nv = a_t - b_t;
-    return nu.sign() == sd && (den - nu).sign() == sd && nv.sign() == sd && (den - nv).sign() == sd;
-}
-
 /// Chernyaev's test (Custodio et al. 2013, Sec. 3.1): joined iff a < 0, t_max = -b/2a in (0, 1)
 /// and the slice at t_max joins A and C (for the tunnel cases the slice's own sign pattern is read,
 /// so condition (iii) F(t_max) > 0 becomes "the slice joins them").

@@ -50,14 +50,6 @@ public:
             }
         }
     }
-    bool operator()(T v) const
-    {
-        if constexpr (std::is_integral_v<T>) {
-            return mode_ == Mode::compare ? v >= threshold_ : mode_ == Mode::all;
-        } else {
-            return static_cast<double>(v) >= iso_;
-        }
-    }
     /// flags[i] = 1 if row[i] is above, else 0.
     void row(const T* row, std::int64_t n, std::uint8_t* flags) const
     {
@@ -124,34 +116,39 @@ private:
     std::vector<std::int64_t> count_;
 };
 
-/// Rows of `len` values for sample rows (j, k), direct-mapped on the low `bits` bits of j and k:
-/// a pass over the cell rows of a slab asks for rows j..j+2^bits-1 and k..k+2^bits-1 at once at
-/// most, which never share a slot. Each slot also holds one number (`extra`) about its row.
-template <class V> class RowCache {
+/// Vertex ids of the edges owned by four sample rows, one slot per parity of (j, k): a cell row
+/// (j, k) reads rows j..j+1 of slices k..k+1, which never share a slot, and the next cell row
+/// along j finds two of them already filled. Each slot also keeps where its row's interior
+/// vertices start.
+class IdRows {
 public:
-    RowCache(int bits, std::size_t len)
-        : bits_(bits), mask_((std::int64_t{1} << bits) - 1), data_((std::size_t{1} << (2 * bits)) * len),
-          key_(std::size_t{1} << (2 * bits), {-1, -1}), extra_(std::size_t{1} << (2 * bits), 0), len_(len)
+    explicit IdRows(std::int64_t nx) : ids_(4 * 3 * static_cast<std::size_t>(nx)), len_(3 * static_cast<std::size_t>(nx)) {}
+    /// Row (j, k); `fresh` when its slot held another row and must be filled.
+    std::uint32_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& interior_start)
     {
-    }
-    /// Row (j, k); `fresh` is set when its slot held another row and must be filled.
-    V* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& extra)
-    {
-        const auto slot = static_cast<std::size_t>((j & mask_) | (k & mask_) << bits_);
+        const auto slot = static_cast<std::size_t>((j & 1) | (k & 1) << 1);
         fresh = key_[slot][0] != j || key_[slot][1] != k;
         key_[slot] = {j, k};
-        extra = &extra_[slot];
-        return &data_[slot * len_];
+        interior_start = &interior_start_[slot];
+        return &ids_[slot * len_];
     }
 
 private:
-    int bits_;
-    std::int64_t mask_;
-    std::vector<V> data_;
-    std::vector<std::array<std::int64_t, 2>> key_;
-    std::vector<std::int64_t> extra_;
+    std::vector<std::uint32_t> ids_;
     std::size_t len_;
+    std::array<std::int64_t, 2> key_[4] = {{-1, -1}, {-1, -1}, {-1, -1}, {-1, -1}};
+    std::int64_t interior_start_[4] = {};
 };
+
+/// Bits 0..2: which of the x, y, z edges owned by sample i of a row cross, from the above-flags of
+/// the row (f), of the row at j + 1 (fy) and of the row at k + 1 (fz). At the grid's last row or
+/// slice pass f itself for fy or fz: those edges do not exist and never cross.
+inline unsigned crossed_edges(const std::uint8_t* f, const std::uint8_t* fy, const std::uint8_t* fz, std::int64_t i,
+                              std::int64_t nx)
+{
+    return static_cast<unsigned>(i + 1 < nx && f[i] != f[i + 1]) | static_cast<unsigned>(f[i] != fy[i]) << 1 |
+           static_cast<unsigned>(f[i] != fz[i]) << 2;
+}
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 
@@ -224,15 +221,12 @@ public:
     }
 
 private:
-    /// One thread's working rows: above-flags of sample rows, vertex ids of the edges sample rows
-    /// own, and the column codes of the current cell row. O(nx) memory.
+    /// One thread's working memory: above-flags of three slices, vertex ids of four sample rows,
+    /// and the column codes of the current cell row. O(nx * ny) bytes.
     struct Scratch {
-        Scratch(std::int64_t nx, std::int64_t ny)
-            : flags(nx, ny), ids(1, static_cast<std::size_t>(3 * nx)), columns(static_cast<std::size_t>(nx))
-        {
-        }
+        Scratch(std::int64_t nx, std::int64_t ny) : flags(nx, ny), ids(nx), columns(static_cast<std::size_t>(nx)) {}
         SliceFlags flags;
-        RowCache<std::uint32_t> ids;
+        IdRows ids;
         std::vector<std::uint8_t> columns;
     };
 
@@ -293,15 +287,12 @@ private:
             auto id = static_cast<std::uint32_t>(row_vertices_[r]);
             // outside the range no edge crosses: those slots are never read for a vertex
             for (std::int64_t i = range_[r][0]; i < range_[r][1]; ++i) {
-                const bool cx = i + 1 < nx_ && f[i] != f[i + 1];
-                ids[3 * i] = cx ? id : kNoVertex;
-                id += cx;
-                const bool cy = f[i] != fy[i];
-                ids[3 * i + 1] = cy ? id : kNoVertex;
-                id += cy;
-                const bool cz = f[i] != fz[i];
-                ids[3 * i + 2] = cz ? id : kNoVertex;
-                id += cz;
+                const unsigned crossed = crossed_edges(f, fy, fz, i, nx_);
+                for (std::int64_t axis = 0; axis < 3; ++axis) {
+                    const bool c = (crossed >> axis) & 1u;
+                    ids[3 * i + axis] = c ? id : kNoVertex;
+                    id += c;
+                }
             }
             *end = id;
         }
@@ -336,13 +327,11 @@ private:
         std::int64_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
         const std::uint8_t* f = flags(j, k, s, n0);
         n1 = n2 = n3 = n0;
-        if (j + 1 < ny_) flags(j + 1, k, s, n1);
-        if (k + 1 < nz_) flags(j, k + 1, s, n2);
+        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s, n1) : f;
+        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
         if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
         if ((n0 == 0 || n0 == nx_) && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
         const auto r = static_cast<std::size_t>(row_index(j, k));
-        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
-        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
         // crossed edges owned by the row: flags are 0 or 1, so != is ^ and the sum vectorises
         std::uint32_t crossed = 0;
         for (std::int64_t i = 0; i + 1 < nx_; ++i) crossed += static_cast<std::uint32_t>(f[i] ^ f[i + 1]);
@@ -350,13 +339,10 @@ private:
         std::int64_t vertices = crossed, triangles = 0;
         std::int64_t lo = nx_, hi = 0;
         if (crossed != 0) {
-            const auto owns = [&](std::int64_t i) {
-                return (i + 1 < nx_ && f[i] != f[i + 1]) || f[i] != fy[i] || f[i] != fz[i];
-            };
             lo = 0;
-            while (!owns(lo)) ++lo;
+            while (crossed_edges(f, fy, fz, lo, nx_) == 0) ++lo;
             hi = nx_;
-            while (!owns(hi - 1)) --hi;
+            while (crossed_edges(f, fy, fz, hi - 1, nx_) == 0) --hi;
         }
         if (j + 1 < ny_ && k + 1 < nz_) {
             column_codes(j, k, s);
@@ -374,8 +360,8 @@ private:
             }
         }
         if (hi > lo) range_[r] = {static_cast<std::int32_t>(lo), static_cast<std::int32_t>(hi)};
-        row_vertices_[static_cast<std::size_t>(row_index(j, k)) + 1] = vertices;
-        row_triangles_[static_cast<std::size_t>(row_index(j, k)) + 1] = triangles;
+        row_vertices_[r + 1] = vertices;
+        row_triangles_[r + 1] = triangles;
     }
 
     /// Crossing of the edge from sample p along axis, as (parameter in [0,1]).
