@@ -68,7 +68,9 @@ void run_extract(const ExtractArgs& args)
     }
     const double seconds = median(runs);
     MeshTopology topology;
+    MeshGeometry geometry;
     if (args.topology) topology = mesh_topology(mesh);
+    if (args.topology && args.json) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
     if (!args.output.empty()) io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii});
 
     const int threads = args.threads > 0 ? args.threads
@@ -89,6 +91,7 @@ void run_extract(const ExtractArgs& args)
                  {"threads", threads},
                  {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
                  {"topology", args.topology ? topology_json(topology) : Json(nullptr)},
+                 {"geometry", args.topology ? geometry_json(geometry) : Json(nullptr)},
                  {"subcases", subcases}};
         print_json(out);
         return;

@@ -16,6 +16,7 @@ namespace {
 struct TopoArgs {
     std::string input;
     bool json = false;
+    bool geometry = true;
 };
 
 const char* yes_no(bool b) { return b ? "yes" : "no"; }
@@ -24,6 +25,8 @@ void run_topo(const TopoArgs& args)
 {
     const Mesh mesh = io::read_mesh(args.input);
     const MeshTopology t = mesh_topology(mesh);
+    MeshGeometry g;
+    if (args.geometry) g = mesh_geometry(mesh);
     if (args.json) {
         Json out{{"file", args.input},
                  {"vertices", t.vertices},
@@ -31,6 +34,7 @@ void run_topo(const TopoArgs& args)
                  {"faces", t.faces},
                  {"file_vertices", mesh.vertex_count()}};
         out.update(topology_json(t));
+        out["geometry"] = args.geometry ? geometry_json(g) : Json(nullptr);
         print_json(out);
         return;
     }
@@ -49,6 +53,20 @@ void run_topo(const TopoArgs& args)
               << t.nonmanifold_vertices << '\n'
               << "degenerate triangles " << t.degenerate_triangles << '\n'
               << "closed " << yes_no(t.closed) << ", oriented " << yes_no(t.oriented) << '\n';
+    if (args.geometry) {
+        std::cout << "in space: " << (g.embedded() ? "embedded" : "NOT embedded") << "; " << g.positions
+                  << " distinct positions, coincident vertices " << g.coincident_vertices
+                  << ", zero-area triangles " << g.zero_area_triangles << ", intersecting triangle pairs "
+                  << g.intersecting_pairs << '\n';
+        for (const auto& pair : g.intersection_examples) {
+            std::cout << "  triangles " << pair[0] << " and " << pair[1] << " meet improperly\n";
+        }
+        const MeshTopology& w = g.welded;
+        std::cout << "welded by position: " << w.vertices << " vertices, euler " << w.euler << ", betti "
+                  << w.components << " " << w.b1 << " " << w.closed_components << ", boundary loops "
+                  << w.boundary_loops << ", non-manifold edges " << w.nonmanifold_edges
+                  << ", non-manifold vertices " << w.nonmanifold_vertices << '\n';
+    }
     if (t.nonmanifold_edges != 0 || t.nonmanifold_vertices != 0) {
         std::cout << "note: the mesh is not a manifold, so b1 = b0 + b2 - euler is not its first Betti number\n";
     }
@@ -62,12 +80,16 @@ void add_topo(CLI::App& app)
     CLI::App* cmd = app.add_subcommand("topo", "Topology of a mesh file: Euler characteristic, Betti numbers, manifoldness");
     cmd->add_option("MESH", args->input, "Mesh: .ply .obj .stl .off")->required();
     cmd->add_flag("--json", args->json, "Print one JSON object");
+    cmd->add_flag("!--no-geometry", args->geometry,
+                  "Skip the checks in space (coincident vertices, zero-area and intersecting triangles)");
     cmd->footer(
         "Reads MESH and prints its combinatorial invariants: vertices used by triangles (V), edges\n"
         "(E), triangles (F), the Euler characteristic V - E + F, the Betti numbers b0 (components),\n"
         "b1 and b2 (closed components), boundary edges and loops, non-manifold edges (more than two\n"
         "triangles) and vertices (more than one fan), degenerate triangles, and whether the mesh is\n"
-        "closed and consistently oriented. A sphere-like closed surface has euler 2 and betti 1 0 1;\n"
+        "closed and consistently oriented; then, in space: coincident vertices, zero-area triangles\n"
+        "and pairs of triangles that meet other than at a shared edge or corner (exact predicates),\n"
+        "and the same invariants after welding vertices by position. A sphere-like closed surface has euler 2 and betti 1 0 1;\n"
         "a torus euler 0 and betti 1 2 1. STL files have no shared vertices: coincident ones are\n"
         "welded when read.\n"
         "\n"

@@ -210,6 +210,19 @@ Json topology_json(const MeshTopology& t)
                 {"oriented", t.oriented}};
 }
 
+Json geometry_json(const MeshGeometry& g)
+{
+    Json examples = Json::array();
+    for (const auto& pair : g.intersection_examples) examples.push_back({pair[0], pair[1]});
+    return Json{{"embedded", g.embedded()},
+                {"positions", g.positions},
+                {"coincident_vertices", g.coincident_vertices},
+                {"zero_area_triangles", g.zero_area_triangles},
+                {"intersecting_pairs", g.intersecting_pairs},
+                {"intersection_examples", examples},
+                {"welded", topology_json(g.welded)}};
+}
+
 namespace {
 
 bool is_flat(const Json& json)

@@ -68,6 +68,9 @@ Json volume_json(const std::string& path, const Volume& volume);
 /// {"euler", "betti", "components", "closed_components", "boundary_edges", "boundary_loops",
 ///  "nonmanifold_edges", "nonmanifold_vertices", "degenerate_triangles", "closed", "oriented"}.
 Json topology_json(const MeshTopology& topology);
+/// The mesh in space (mesh_geometry): embedded, coincident vertices, zero-area triangles,
+/// intersecting pairs (with examples) and the topology of the position-welded mesh.
+Json geometry_json(const MeshGeometry& geometry);
 
 /// Writes one JSON object to stdout, indented, with a final newline.
 void print_json(const Json& json);

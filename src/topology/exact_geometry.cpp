@@ -1,0 +1,272 @@
+// Exact predicates and triangle intersection tests (contract in exact_geometry.hpp).
+
+#include "topology/exact_geometry.hpp"
+
+#include <cmath>
+#include <cstddef>
+#include <gmpxx.h>
+#include <limits>
+
+namespace cmc33::detail {
+namespace {
+
+constexpr double kEps = std::numeric_limits<double>::epsilon() / 2; // unit roundoff u = 2^-53
+
+thread_local PredicateStats g_stats;
+
+int sign_of(double x) { return (x > 0) - (x < 0); }
+
+/// a - b exactly as hi + lo (Knuth's two-sum on a and -b).
+void two_diff(double a, double b, double& hi, double& lo)
+{
+    hi = a - b;
+    const double bv = a - hi;
+    const double av = hi + bv;
+    lo = (a - av) + (bv - b);
+}
+
+void two_sum(double a, double b, double& hi, double& lo)
+{
+    hi = a + b;
+    const double bv = hi - a;
+    const double av = hi - bv;
+    lo = (a - av) + (b - bv);
+}
+
+/// The exact sign of the sum of n doubles, or 2 when distillation did not settle it.
+/// Each pass replaces the terms by error-free two-sums that leave the exact sum unchanged and
+/// gather it in the last term; once that term outweighs all the others, it has the sum's sign.
+int sign_of_sum(double* x, std::size_t n)
+{
+    for (int pass = 0; pass < 64; ++pass) {
+        for (std::size_t i = 1; i < n; ++i) two_sum(x[i], x[i - 1], x[i], x[i - 1]);
+        double rest = 0;
+        for (std::size_t i = 0; i + 1 < n; ++i) rest += std::fabs(x[i]);
+        const double last = std::fabs(x[n - 1]);
+        if (rest == 0) return sign_of(x[n - 1]);
+        // rest is computed with n - 1 roundings: true rest <= rest * (1 + 2 n u)
+        if (last > rest * (1 + 2 * static_cast<double>(n) * kEps)) return sign_of(x[n - 1]);
+    }
+    return 2;
+}
+
+/// x * y * z as four exact terms (inputs are differences of floats: no underflow can occur).
+void triple_product(double x, double y, double z, double* out)
+{
+    const double p = x * y;
+    const double e = std::fma(x, y, -p);
+    out[0] = p * z;
+    out[1] = std::fma(p, z, -out[0]);
+    out[2] = e * z;
+    out[3] = std::fma(e, z, -out[2]);
+}
+
+bool exact_differences(const double* a, const double* b, double* out, int n)
+{
+    for (int i = 0; i < n; ++i) {
+        double lo = 0;
+        two_diff(a[i], b[i], out[i], lo);
+        if (lo != 0) return false;
+    }
+    return true;
+}
+
+int orient3d_rational(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+{
+    mpq_class m[3][3];
+    const Point3* rows[3] = {&a, &b, &c};
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            const auto kk = static_cast<std::size_t>(k);
+            m[r][k] = mpq_class((*rows[r])[kk]) - mpq_class(d[kk]);
+        }
+    const mpq_class det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                          m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    return sgn(det);
+}
+
+int orient2d_rational(double ax, double ay, double bx, double by, double cx, double cy)
+{
+    const mpq_class det = (mpq_class(ax) - cx) * (mpq_class(by) - cy) - (mpq_class(ay) - cy) * (mpq_class(bx) - cx);
+    return sgn(det);
+}
+
+} // namespace
+
+PredicateStats& predicate_stats() noexcept { return g_stats; }
+
+int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+{
+    const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
+    const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
+    const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
+    const double m1 = bdy * cdz, m2 = bdz * cdy, m3 = cdy * adz, m4 = cdz * ady, m5 = ady * bdz, m6 = adz * bdy;
+    const double det = adx * (m1 - m2) + bdx * (m3 - m4) + cdx * (m5 - m6);
+    const double permanent = std::fabs(adx) * (std::fabs(m1) + std::fabs(m2)) +
+                             std::fabs(bdx) * (std::fabs(m3) + std::fabs(m4)) +
+                             std::fabs(cdx) * (std::fabs(m5) + std::fabs(m6));
+    // Each of the six terms carries at most 7 roundings relative to its size (three differences,
+    // two products, the inner difference, the sums): 8u of the permanent bounds the error.
+    const double bound = 8.5 * kEps * permanent;
+    if (det > bound || -det > bound) {
+        ++g_stats.filtered;
+        return sign_of(det);
+    }
+    double da[3], db[3], dc[3];
+    if (exact_differences(a.data(), d.data(), da, 3) && exact_differences(b.data(), d.data(), db, 3) &&
+        exact_differences(c.data(), d.data(), dc, 3)) {
+        double terms[24];
+        triple_product(da[0], db[1], dc[2], terms + 0);
+        triple_product(-da[0], db[2], dc[1], terms + 4);
+        triple_product(db[0], dc[1], da[2], terms + 8);
+        triple_product(-db[0], dc[2], da[1], terms + 12);
+        triple_product(dc[0], da[1], db[2], terms + 16);
+        triple_product(-dc[0], da[2], db[1], terms + 20);
+        const int s = sign_of_sum(terms, 24);
+        if (s != 2) {
+            ++g_stats.expansion;
+            return s;
+        }
+    }
+    ++g_stats.rational;
+    return orient3d_rational(a, b, c, d);
+}
+
+int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop)
+{
+    const auto u = static_cast<std::size_t>(drop == 0 ? 1 : 0), v = static_cast<std::size_t>(drop == 2 ? 1 : 2);
+    const double acx = a[u] - c[u], acy = a[v] - c[v], bcx = b[u] - c[u], bcy = b[v] - c[v];
+    const double l = acx * bcy, r = acy * bcx;
+    const double det = l - r;
+    const double bound = 4.5 * kEps * (std::fabs(l) + std::fabs(r));
+    if (det > bound || -det > bound) {
+        ++g_stats.filtered;
+        return sign_of(det);
+    }
+    const double pa[2] = {a[u], a[v]}, pb[2] = {b[u], b[v]}, pc[2] = {c[u], c[v]};
+    double dac[2], dbc[2];
+    if (exact_differences(pa, pc, dac, 2) && exact_differences(pb, pc, dbc, 2)) {
+        double terms[4];
+        terms[0] = dac[0] * dbc[1];
+        terms[1] = std::fma(dac[0], dbc[1], -terms[0]);
+        terms[2] = -(dac[1] * dbc[0]);
+        terms[3] = -std::fma(dac[1], dbc[0], terms[2]);
+        const int s = sign_of_sum(terms, 4);
+        if (s != 2) {
+            ++g_stats.expansion;
+            return s;
+        }
+    }
+    ++g_stats.rational;
+    return orient2d_rational(a[u], a[v], b[u], b[v], c[u], c[v]);
+}
+
+bool collinear(const Point3& a, const Point3& b, const Point3& c)
+{
+    return orient2d(a, b, c, 0) == 0 && orient2d(a, b, c, 1) == 0 && orient2d(a, b, c, 2) == 0;
+}
+
+int projection_axis(const Point3& a, const Point3& b, const Point3& c)
+{
+    for (int drop = 2; drop > 0; --drop)
+        if (orient2d(a, b, c, drop) != 0) return drop;
+    return 0;
+}
+
+namespace {
+
+/// q lies on the closed segment ab, given that a, b, q are collinear.
+bool on_segment(const Point3& a, const Point3& b, const Point3& q)
+{
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (q[k] < std::fmin(a[k], b[k]) || q[k] > std::fmax(a[k], b[k])) return false;
+    }
+    return true;
+}
+
+/// Closed segments pq and ab meet, all four points in one plane (projected by `drop`).
+bool segments_meet_2d(const Point3& p, const Point3& q, const Point3& a, const Point3& b, int drop)
+{
+    const int o1 = orient2d(p, q, a, drop), o2 = orient2d(p, q, b, drop);
+    const int o3 = orient2d(a, b, p, drop), o4 = orient2d(a, b, q, drop);
+    if (o1 * o2 < 0 && o3 * o4 < 0) return true;
+    return (o1 == 0 && on_segment(p, q, a)) || (o2 == 0 && on_segment(p, q, b)) || (o3 == 0 && on_segment(a, b, p)) ||
+           (o4 == 0 && on_segment(a, b, q));
+}
+
+bool point_in_triangle_2d(const Point3& p, const Point3& a, const Point3& b, const Point3& c, int drop)
+{
+    const int s = orient2d(a, b, c, drop);
+    return orient2d(a, b, p, drop) * s >= 0 && orient2d(b, c, p, drop) * s >= 0 && orient2d(c, a, p, drop) * s >= 0;
+}
+
+/// Closed segment pq and closed triangle abc in one plane.
+bool segment_meets_triangle_2d(const Point3& p, const Point3& q, const Point3& a, const Point3& b, const Point3& c)
+{
+    const int drop = projection_axis(a, b, c);
+    return point_in_triangle_2d(p, a, b, c, drop) || point_in_triangle_2d(q, a, b, c, drop) ||
+           segments_meet_2d(p, q, a, b, drop) || segments_meet_2d(p, q, b, c, drop) || segments_meet_2d(p, q, c, a, drop);
+}
+
+/// Segment v->a leaves v into triangle (v, c, d) — which holds when a is in the plane of the
+/// triangle and inside the closed angle at v (the triangle covers a neighbourhood of v in it).
+bool edge_enters_at_shared_corner(const Point3& v, const Point3& a, const Point3& c, const Point3& d)
+{
+    if (orient3d(v, c, d, a) != 0) return false;
+    const int drop = projection_axis(v, c, d);
+    const int s = orient2d(v, c, d, drop);
+    return orient2d(v, c, a, drop) * s >= 0 && orient2d(v, a, d, drop) * s >= 0;
+}
+
+bool triangles_meet(const std::array<Point3, 3>& t, const std::array<Point3, 3>& u)
+{
+    // separated by a plane of one of them: all corners of the other strictly on one side
+    for (int pass = 0; pass < 2; ++pass) {
+        const auto& x = pass == 0 ? t : u;
+        const auto& y = pass == 0 ? u : t;
+        const int s0 = orient3d(x[0], x[1], x[2], y[0]), s1 = orient3d(x[0], x[1], x[2], y[1]),
+                  s2 = orient3d(x[0], x[1], x[2], y[2]);
+        if ((s0 > 0 && s1 > 0 && s2 > 0) || (s0 < 0 && s1 < 0 && s2 < 0)) return false;
+    }
+    // two closed triangles meet iff an edge of one meets the other
+    for (int i = 0; i < 3; ++i) {
+        const auto a = static_cast<std::size_t>(i), b = static_cast<std::size_t>((i + 1) % 3);
+        if (segment_meets_triangle(t[a], t[b], u[0], u[1], u[2])) return true;
+        if (segment_meets_triangle(u[a], u[b], t[0], t[1], t[2])) return true;
+    }
+    return false;
+}
+
+} // namespace
+
+bool segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, const Point3& b, const Point3& c)
+{
+    const int op = orient3d(a, b, c, p), oq = orient3d(a, b, c, q);
+    if (op == 0 && oq == 0) return segment_meets_triangle_2d(p, q, a, b, c);
+    if (op * oq > 0) return false;
+    // the segment meets the plane in one point; the line pq passes through the closed triangle iff
+    // it sees the three edges turning the same way
+    const int s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+    return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+}
+
+bool triangles_meet_improperly(const std::array<Point3, 3>& t, const std::array<Point3, 3>& u, int shared)
+{
+    if (shared == 0) return triangles_meet(t, u);
+    if (shared == 1) {
+        // t = (v, a, b), u = (v, c, d): the convex set t ∩ u holds v; it holds more iff an
+        // opposite edge meets the other triangle or an edge at v runs into the other triangle.
+        const Point3 &v = t[0], &a = t[1], &b = t[2], &c = u[1], &d = u[2];
+        return segment_meets_triangle(a, b, v, c, d) || segment_meets_triangle(c, d, v, a, b) ||
+               edge_enters_at_shared_corner(v, a, c, d) || edge_enters_at_shared_corner(v, b, c, d) ||
+               edge_enters_at_shared_corner(v, c, a, b) || edge_enters_at_shared_corner(v, d, a, b);
+    }
+    // shared edge (t[0], t[1]): two planes through one line meet only in it, so the triangles
+    // overlap only when coplanar with their third corners on the same side of the edge
+    if (orient3d(t[0], t[1], t[2], u[2]) != 0) return false;
+    const int drop = projection_axis(t[0], t[1], t[2]);
+    return orient2d(t[0], t[1], t[2], drop) * orient2d(t[0], t[1], u[2], drop) > 0;
+}
+
+} // namespace cmc33::detail
