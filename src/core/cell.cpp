@@ -6,6 +6,7 @@
 #include "cmc33/error.hpp"
 #include "core/cube.hpp"
 #include "core/decide.hpp"
+#include "core/placement.hpp"
 #include "tables/mc33_tables.hpp"
 
 namespace cmc33 {
@@ -30,11 +31,11 @@ CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method 
     const detail::Decision d = detail::decide(values.data(), iso, config, method, &report);
     report.subcase = d.subcase;
     const detail::Tiling& tl = d.variant->tilings[d.tiling];
-    // Crossing positions in the unit cube; interior vertices are means of crossings, as in extract().
+    // Crossing positions in the unit cube, placed as extract() places them (core/placement.hpp).
     double crossing[12][3];
     for (int e = 0; e < 12; ++e) {
         const int a = detail::kEdgeCorners[e][0], b = detail::kEdgeCorners[e][1];
-        const double t = (v[a] >= 0) != (v[b] >= 0) ? v[a] / (v[a] - v[b]) : 0.5;
+        const double t = (v[a] >= 0) != (v[b] >= 0) ? detail::clamp_crossing(v[a] / (v[a] - v[b]), detail::kMinCrossing) : 0.5;
         for (int c = 0; c < 3; ++c) crossing[e][c] = ((a >> c) & 1) + (c == e / 4 ? t : 0.0);
     }
     int index[12];
@@ -46,15 +47,9 @@ CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method 
     }
     const int first_interior = static_cast<int>(report.mesh.vertex_count());
     for (int q = 0; q < tl.interior_count; ++q) {
-        const unsigned mask = detail::kInteriorMasks[tl.first_interior + q];
-        double p[3] = {0, 0, 0};
-        int n = 0;
-        for (int e = 0; e < 12; ++e) {
-            if (!((mask >> e) & 1u)) continue;
-            for (int c = 0; c < 3; ++c) p[c] += crossing[e][c];
-            ++n;
-        }
-        for (double x : p) report.mesh.positions.push_back(static_cast<float>(x / n));
+        double p[3];
+        detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing, p);
+        for (double x : p) report.mesh.positions.push_back(static_cast<float>(x));
     }
     for (int q = 0; q < 3 * tl.triangle_count; ++q) {
         const int code = detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3 + static_cast<std::size_t>(q)];

@@ -26,6 +26,7 @@
 #include "core/cube.hpp"
 #include "core/decide.hpp"
 #include "core/parallel.hpp"
+#include "core/placement.hpp"
 #include "tables/mc33_tables.hpp"
 
 namespace cmc33 {
@@ -156,7 +157,7 @@ template <class T> class Extractor {
 public:
     Extractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
         : g_(g), iso_(iso), above_(iso), opt_(opt), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()),
-          threads_(detail::resolve_threads(opt.threads))
+          threads_(detail::resolve_threads(opt.threads)), delta_(min_crossing(g))
     {
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
@@ -364,11 +365,28 @@ private:
         row_triangles_[r + 1] = triangles;
     }
 
-    /// Crossing of the edge from sample p along axis, as (parameter in [0,1]).
+    /// The crossing parameter of the edge from sample value a to b, in [delta, 1 - delta]
+    /// (src/core/placement.hpp: never on a sample, so ties do not collapse triangles).
     double crossing(T a, T b) const
     {
         const double va = static_cast<double>(a), vb = static_cast<double>(b);
-        return std::clamp((iso_ - va) / (vb - va), 0.0, 1.0); // ends differ in sign: vb != va
+        return detail::clamp_crossing((iso_ - va) / (vb - va), delta_); // ends differ in sign: vb != va
+    }
+
+    /// delta of placement.hpp for this grid: 2^-10 of an edge, or more where the output floats
+    /// cannot tell a point delta along an edge from the sample (16 units in the last place of the
+    /// largest coordinate, at most 1/8 of an edge).
+    static double min_crossing(const GridView<T>& g)
+    {
+        double largest = 0, shortest = std::numeric_limits<double>::infinity();
+        for (std::size_t a = 0; a < 3; ++a) {
+            const double far = g.origin[a] + g.spacing[a] * static_cast<double>(g.dims[a] - 1);
+            largest = std::max({largest, std::fabs(g.origin[a]), std::fabs(far)});
+            shortest = std::min(shortest, std::fabs(g.spacing[a]));
+        }
+        if (!(largest > 0) || !(shortest > 0) || !std::isfinite(largest)) return detail::kMinCrossing;
+        const double ulp = std::ldexp(1.0, std::ilogb(largest) - 23);
+        return std::clamp(16 * ulp / shortest, detail::kMinCrossing, 0.125);
     }
 
     std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k) const
@@ -441,9 +459,8 @@ private:
                 edge_id[e] = row[3 * (i + kCornerOffset[c][0]) + e / 4];
             }
             const std::int64_t first_interior = vertex;
-            for (int q = 0; q < tl.interior_count; ++q) {
-                write_interior_vertex(i, j, k, detail::kInteriorMasks[tl.first_interior + q], vertex++, mesh);
-            }
+            if (tl.interior_count > 0) write_interior_vertices(i, j, k, tl, vertex, mesh);
+            vertex += tl.interior_count;
             const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3];
             std::uint32_t* out = &mesh.triangles[static_cast<std::size_t>(tri) * 3];
             for (int q = 0; q < 3 * tl.triangle_count; ++q) {
@@ -454,34 +471,48 @@ private:
         }
     }
 
-    /// An interior vertex: the mean of the crossings on the edges of `mask` (normal likewise).
-    void write_interior_vertex(std::int64_t i, std::int64_t j, std::int64_t k, unsigned mask, std::int64_t id,
-                               Mesh& mesh) const
+    /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
+    /// placement.hpp from the cell's crossings; normals interpolate the corners' gradients.
+    void write_interior_vertices(std::int64_t i, std::int64_t j, std::int64_t k, const detail::Tiling& tl,
+                                 std::int64_t first, Mesh& mesh) const
     {
-        double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
-        int count = 0;
+        T value[8];
+        for (int c = 0; c < 8; ++c) value[c] = at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
+        double crossing_at[12][3] = {};
+        unsigned needed = 0;
+        for (int q = 0; q < tl.interior_count; ++q) {
+            const unsigned code = detail::kInteriorMasks[tl.first_interior + q];
+            for (int e = 0; e < 12; ++e) needed |= static_cast<unsigned>(detail::interior_uses_edge(code, e)) << e;
+        }
         for (int e = 0; e < 12; ++e) {
-            if (!((mask >> e) & 1u)) continue;
-            const int a = kEdgeCorners[e][0], b = kEdgeCorners[e][1], axis = e / 4;
-            const std::int64_t ia[3] = {i + kCornerOffset[a][0], j + kCornerOffset[a][1], k + kCornerOffset[a][2]};
-            const std::int64_t ib[3] = {i + kCornerOffset[b][0], j + kCornerOffset[b][1], k + kCornerOffset[b][2]};
-            const double t = crossing(at(ia[0], ia[1], ia[2]), at(ib[0], ib[1], ib[2]));
-            for (int c = 0; c < 3; ++c) p[c] += static_cast<double>(ia[c]) + (c == axis ? t : 0.0);
-            if (opt_.normals) {
-                const auto ga = gradient(ia[0], ia[1], ia[2]), gb = gradient(ib[0], ib[1], ib[2]);
-                for (int c = 0; c < 3; ++c) {
-                    const std::size_t cc = static_cast<std::size_t>(c);
-                    n[c] += ga[cc] + t * (gb[cc] - ga[cc]);
-                }
+            if (!((needed >> e) & 1u)) continue;
+            const int a = kEdgeCorners[e][0], b = kEdgeCorners[e][1];
+            const double t = crossing(value[a], value[b]);
+            for (int c = 0; c < 3; ++c) crossing_at[e][c] = static_cast<double>(kCornerOffset[a][c]) + (c == e / 4 ? t : 0.0);
+        }
+        std::array<double, 3> grad[8];
+        if (opt_.normals) {
+            for (int c = 0; c < 8; ++c) grad[c] = gradient(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
+        }
+        const double base[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+        for (int q = 0; q < tl.interior_count; ++q) {
+            double p[3];
+            detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
+            const auto id = static_cast<std::size_t>(first + q);
+            float* out = &mesh.positions[id * 3];
+            for (int c = 0; c < 3; ++c) {
+                const std::size_t cc = static_cast<std::size_t>(c);
+                out[c] = static_cast<float>(g_.origin[cc] + g_.spacing[cc] * (base[c] + p[c]));
             }
-            ++count;
+            if (opt_.normals) {
+                double w[8];
+                detail::trilinear_weights(p, w);
+                std::array<double, 3> n{};
+                for (int c = 0; c < 8; ++c)
+                    for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
+                write_normal(&mesh.normals[id * 3], n);
+            }
         }
-        float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
-        for (int c = 0; c < 3; ++c) {
-            const std::size_t cc = static_cast<std::size_t>(c);
-            out[c] = static_cast<float>(g_.origin[cc] + g_.spacing[cc] * (p[c] / count));
-        }
-        if (opt_.normals) write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3], {n[0], n[1], n[2]});
     }
 
     const GridView<T>& g_;
@@ -490,6 +521,7 @@ private:
     ExtractOptions opt_;
     std::int64_t nx_, ny_, nz_;
     int threads_;
+    double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
     std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
     /// Trim range from pass 1, per row r: [range_[r][0], range_[r][1]) holds every sample of row r

@@ -25,7 +25,7 @@ import os
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from cube import (EDGE_CORNERS, ROTATIONS, ambiguous_faces, corner_pos, edge_faces, face_cycle,
                   map_config, map_face)
-from loops import edge_mid, loops, regions
+from loops import edge_mid, face_arcs, loops, regions
 
 SUBCASES = ["0", "1", "2", "3.1", "3.2", "4.1.1", "4.1.2", "5", "6.1.1", "6.1.2", "6.2", "7.1",
             "7.2", "7.3", "7.4.1", "7.4.2", "8", "9", "10.1.1", "10.1.2", "10.2", "11", "12.1.1",
@@ -224,40 +224,106 @@ def disc(loop, interior):
     return [(c, loop[i], loop[(i + 1) % m]) for i in range(m)]
 
 
-def tube(outer, inner_loop, interior):
-    """An annulus between loop `outer` and loop `inner_loop` (both in boundary order) through a
-    ring of interior vertices, one per vertex of `outer`, each the midpoint of that vertex and the
-    nearest-aligned vertex of the other loop."""
-    m, inner = len(outer), list(reversed(inner_loop))
-    n = len(inner)
-    best = None
-    for s in range(n):
-        cost = sum(dist(edge_mid(outer[i]), edge_mid(inner[(s + round(i * n / m)) % n])) for i in range(m))
-        if best is None or cost < best[0] - 1e-12:
-            best = (cost, s)
-    s = best[1]
-    ring = []
-    for i in range(m):
-        interior.append((1 << outer[i]) | (1 << inner[(s + round(i * n / m)) % n]))
-        ring.append(12 + len(interior) - 1)
+# Interior vertex codes (kInteriorMasks): a disc's fan centre is an edge mask (bit e: the mean of
+# the crossings on those edges); a tube vertex is RADIAL | point, the point (0..11: the crossing on
+# that edge, 12 + c: corner c) moved toward the cell's centre (src/core/placement.hpp).
+RADIAL = 0x8000
+CORNER_POINT = 12
+
+# Orientation of face_cycle(f) seen from outside the cell: +1 counter-clockwise.
+FACE_SENSE = {0: -1, 1: 1, 2: 1, 3: -1, 4: -1, 5: 1}
+
+
+def face_pieces(config, joined, f):
+    """The pieces of face f between its arcs (straight chords between crossings): convex polygons,
+    counter-clockwise seen from outside, as lists of points ('c', corner) and ('e', edge). Every
+    piece holds at least one corner."""
+    pc = face_cycle(f)
+    cyc = []
+    for i in range(4):
+        a, b = pc[i], pc[(i + 1) % 4]
+        cyc.append(("c", a))
+        e = next(k for k, (x, y) in enumerate(EDGE_CORNERS) if {x, y} == {a, b})
+        a_above, b_above = (config >> a) & 1, (config >> b) & 1
+        if a_above != b_above:
+            cyc.append(("e", e))
+    chord = {}
+    for e1, e2 in face_arcs(config, joined, f):
+        chord[e1], chord[e2] = e2, e1
+    pos = {item: k for k, item in enumerate(cyc)}
+    pieces, used = [], set()
+    for start in range(len(cyc)):
+        if cyc[start][0] != "c" or cyc[start] in used:
+            continue
+        piece, k = [], start
+        while True:
+            item = cyc[k]
+            piece.append(item)
+            if item[0] == "c":
+                used.add(item)
+            if item[0] == "e" and item[1] in chord:
+                other = ("e", chord[item[1]])
+                piece.append(other)
+                k = (pos[other] + 1) % len(cyc)
+            else:
+                k = (k + 1) % len(cyc)
+            if k == start:
+                break
+        pieces.append(piece if FACE_SENSE[f] > 0 else list(reversed(piece)))
+    return pieces
+
+
+def tube(config, joined, ls, pair, interior):
+    """An annulus joining loops ls[pair[0]] and ls[pair[1]] through the cell, embedded for every
+    position of the crossings. With c the cell's centre, let D be the region of the cell's surface
+    between the two loops (their common side). The tube is
+      - a wall over every arc of the two loops: the trapezoid between the arc and its copy moved
+        toward c (it lies in the plane through c and the arc), and
+      - D's copy moved toward c: every piece of D in a face (a convex polygon) fanned.
+    Seen from c, the walls stand over D's boundary and the rest is a radial graph over D, so no
+    two triangles can meet improperly, and everything but the two loops lies inside the open cell
+    (no triangle edge in a face but the arcs)."""
+    regs, sides = loop_regions(config, joined, ls)
+    (common,) = sides[pair[0]] & sides[pair[1]]
+    region = regs[common]
+    ring = {}
+
+    def r(point):
+        key = point[1] if point[0] == "e" else CORNER_POINT + point[1]
+        if key not in ring:
+            interior.append(RADIAL | key)
+            ring[key] = 12 + len(interior) - 1
+        return ring[key]
+
     tris = []
-    for i in range(m):
-        a, a1, r, r1 = outer[i], outer[(i + 1) % m], ring[i], ring[(i + 1) % m]
-        tris += [(a, a1, r), (r, a1, r1)]
-    # band between the ring (outer side) and the inner loop, walked together once around
-    inner = inner[s:] + inner[:s]
-    i = j = 0
-    while i < m or j < n:
-        if j >= n or (i < m and (i + 1) / m <= (j + 1) / n):
-            tris.append((ring[i % m], ring[(i + 1) % m], inner[j % n]))
-            i += 1
-        else:
-            tris.append((inner[j % n], ring[i % m], inner[(j + 1) % n]))
-            j += 1
-    return tris
+    for idx in pair:
+        loop = [e for e, _ in ls[idx]]
+        m = len(loop)
+        for i in range(m):
+            a, a1 = loop[i], loop[(i + 1) % m]
+            ra, ra1 = r(("e", a)), r(("e", a1))
+            tris += [(a, a1, ra), (ra, a1, ra1)]
+    walls = len(tris)
+    for f in range(6):
+        for piece in face_pieces(config, joined, f):
+            corners = [p[1] for p in piece if p[0] == "c"]
+            if not set(corners) <= region:
+                assert not set(corners) & region
+                continue
+            vs = [r(p) for p in piece]
+            for k in range(1, len(vs) - 1):
+                tris.append((vs[0], vs[k], vs[k + 1]))
+    # the walls run each inner edge r(a_i+1) -> r(a_i); the graph must run it the other way
+    a0 = ls[pair[0]][0][0]
+    a1 = ls[pair[0]][1][0]
+    e = (ring[a0], ring[a1])
+    graph = tris[walls:]
+    if not any((t[i], t[(i + 1) % 3]) == e for t in graph for i in range(3)):
+        graph = [(t[0], t[2], t[1]) for t in graph]
+    return tris[:walls] + graph
 
 
-def tiling(ls, joined_pair=None):
+def tiling(ls, joined_pair=None, config=None, joined=None):
     interior, tris = [], []
     edges = [[e for e, _ in l] for l in ls]
     for idx, l in enumerate(edges):
@@ -265,7 +331,7 @@ def tiling(ls, joined_pair=None):
             continue
         tris += disc(l, interior)
     if joined_pair:
-        tris += tube(edges[joined_pair[0]], edges[joined_pair[1]], interior)
+        tris += tube(config, joined, ls, joined_pair, interior)
     return tris, interior
 
 
@@ -290,7 +356,11 @@ def check_tiling(config, ls, tris, interior, context):
     for arc in arcs:
         assert arc in directed and (arc[1], arc[0]) not in directed, ("arc not used once", context, arc)
     for m in interior:
-        assert m and all(((m >> e) & 1) == 0 or e in crossed for e in range(12)), context
+        if m & RADIAL:
+            point = m & ~RADIAL
+            assert point < 12 + 8 and (point >= 12 or point in crossed), context
+        else:
+            assert m and all(((m >> e) & 1) == 0 or e in crossed for e in range(12)), context
 
 
 def self_test_orientation():
@@ -326,7 +396,7 @@ def variants():
                 axis = test_axis(base, config)
                 v.update(test=TEST_TUNNEL, axis=axis, corner=p)
                 v["tunnel_subcase"] = SUB[name + ".2"]
-                v["tilings"].append(tiling(ls, (i, j)))
+                v["tilings"].append(tiling(ls, (i, j), config, joined))
                 # mc33-lewiner: t_alt from the first crossed edge among P->P^u, P->P^v, P->P^w
                 P = v["corner"]
                 u, w_ = [a for a in range(3) if a != axis]
@@ -355,8 +425,8 @@ def variants():
                 v["tunnel_subcase"] = SUB["13.5.2"]
                 cap_loop = lambda corner: next(i for i, l in enumerate(ls) if all(corner in EDGE_CORNERS[e] for e, _ in l))
                 hexa = next(i for i, l in enumerate(ls) if len(l) == 6)
-                v["tilings"].append(tiling(ls, (cap_loop(s_plus), hexa)))   # tunnel faces s_plus
-                v["tilings"].append(tiling(ls, (cap_loop(s_minus), hexa)))  # tunnel faces s_minus
+                v["tilings"].append(tiling(ls, (cap_loop(s_plus), hexa), config, joined))   # tunnel faces s_plus
+                v["tilings"].append(tiling(ls, (cap_loop(s_minus), hexa), config, joined))  # tunnel faces s_minus
                 # Lewiner's route (Custodio et al., Appendix A): along x from the isolated above
                 # corner (lewiner_corner = s_plus, which decide() also reads as that corner), t_alt
                 # where the field crosses the x edge leaving it.
