@@ -27,8 +27,8 @@ void run_dataset(const DatasetArgs& args)
         throw UsageError("--size " + std::to_string(args.options.size) +
                          " is out of range; expected " + std::to_string(min_size) + " to 1024");
     }
-    if (args.options.cells + args.options.grids + args.options.closed == 0) {
-        throw UsageError("nothing to write: --cells, --grids and --closed are all 0");
+    if (args.options.cells + args.options.grids + args.options.closed + args.options.ties == 0) {
+        throw UsageError("nothing to write: --cells, --grids, --closed and --ties are all 0");
     }
     DatasetOptions options = args.options;
     options.progress = progress_line(args.progress, "fields");
@@ -39,14 +39,14 @@ void run_dataset(const DatasetArgs& args)
         end_progress_line();
         throw;
     }
-    std::cout << "wrote " << s.written[0] << " cells, " << s.written[1] << " grids and "
-              << s.written[2] << " closed grids to " << args.output
+    std::cout << "wrote " << s.written[0] << " cells, " << s.written[1] << " grids, " << s.written[2]
+              << " closed grids and " << s.written[3] << " tie grids to " << args.output
               << "/ (manifest.tsv, README.txt) in " << sig(s.seconds, 3) << " s\n";
-    const std::int64_t left_out = s.undetermined[0] + s.undetermined[1] + s.undetermined[2];
+    const std::int64_t left_out = s.undetermined[0] + s.undetermined[1] + s.undetermined[2] + s.undetermined[3];
     if (left_out != 0) {
         std::cout << "left out " << left_out << " fields whose topology is undetermined ("
                   << s.undetermined[0] << " cells, " << s.undetermined[1] << " grids, "
-                  << s.undetermined[2] << " closed): their numbers are missing\n";
+                  << s.undetermined[2] << " closed, " << s.undetermined[3] << " ties): their numbers are missing\n";
     }
     std::cout << "check an extractor with: cmc33 verify --dataset " << args.output
               << " --cmd 'TOOL {in} {iso} {out}'\n";
@@ -73,6 +73,10 @@ void add_dataset(CLI::App& app)
                     "Random grids whose surfaces are all closed (default 1000)")
         ->type_name("N")
         ->check(CLI::NonNegativeNumber);
+    cmd->add_option("--ties", args->options.ties,
+                    "Random grids of integers -2..2 or -3..3 at iso 0, ties everywhere (default 0)")
+        ->type_name("N")
+        ->check(CLI::NonNegativeNumber);
     cmd->add_option("--size", args->options.size, "Samples per axis of the grids (default 5)")
         ->type_name("N");
     cmd->add_option("--seed", args->options.seed, "Seed of the random fields (default 1)")
@@ -83,7 +87,7 @@ void add_dataset(CLI::App& app)
     cmd->add_flag("--progress", args->progress,
                   "Progress lines on stderr even when it is not a terminal");
     cmd->footer(
-        "Writes OUT/cells/cell-000001.nrrd ..., OUT/grids/..., OUT/closed/... (float NRRD), and\n"
+        "Writes OUT/cells/cell-000001.nrrd ..., OUT/grids/..., OUT/closed/..., OUT/ties/... (float NRRD), and\n"
         "OUT/manifest.tsv: one line per file with the isovalue and the Euler characteristic, "
         "Betti\n"
         "numbers and boundary loops its isosurface must have (a sample equal to the isovalue "

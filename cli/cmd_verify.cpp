@@ -32,6 +32,7 @@ struct VerifyArgs {
     std::int64_t cells = 0;
     std::int64_t grids = 0;
     std::int64_t closed = 0;
+    std::int64_t ties = 0;
     int size = 5;
     std::uint64_t seed = 1;
     std::vector<std::string> methods;
@@ -45,7 +46,7 @@ struct VerifyArgs {
     std::vector<CLI::Option*> random_only; ///< options that make no sense with --dataset
 };
 
-constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed"};
+constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed", "ties"};
 
 std::vector<Method> parse_methods(const std::vector<std::string>& names)
 {
@@ -103,6 +104,7 @@ Json report_json(const VerifyReport& r, const VerifyArgs& args)
                            {"undetermined", m.undetermined},
                            {"nonmanifold", m.nonmanifold},
                            {"unoriented", m.unoriented},
+                           {"not_embedded", m.not_embedded},
                            {"errors", m.errors},
                            {"by_kind", by_kind},
                            {"subcases", subcases},
@@ -145,13 +147,15 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
     for (const MethodReport& m : r.methods) name_width = std::max(name_width, m.name.size());
     std::cout << pad("method", name_width, false) << "  " << pad("checked", 9) << pad("matched", 9)
               << pad("mismatched", 12) << pad("undetermined", 14) << pad("non-manifold", 14)
-              << "  mismatched cells/grids/closed\n";
+              << pad("not embedded", 14) << "  mismatched cells/grids/closed/ties\n";
     for (const MethodReport& m : r.methods) {
         std::cout << pad(m.name, name_width, false) << "  " << pad(std::to_string(m.checked), 9)
                   << pad(std::to_string(m.matched), 9) << pad(std::to_string(m.mismatched), 12)
                   << pad(std::to_string(m.undetermined), 14)
-                  << pad(std::to_string(m.nonmanifold), 14) << "  " << m.mismatched_by_kind[0]
-                  << "/" << m.mismatched_by_kind[1] << "/" << m.mismatched_by_kind[2] << '\n';
+                  << pad(std::to_string(m.nonmanifold), 14) << pad(std::to_string(m.not_embedded), 14)
+                  << "  " << m.mismatched_by_kind[0]
+                  << "/" << m.mismatched_by_kind[1] << "/" << m.mismatched_by_kind[2] << "/"
+                  << m.mismatched_by_kind[3] << '\n';
     }
     for (const MethodReport& m : r.methods) {
         if (m.errors != 0)
@@ -215,8 +219,8 @@ void check_usage(const VerifyArgs& args)
     }
     if (!args.command.empty())
         throw UsageError("--cmd needs --dataset DIR (the files to run it on)");
-    if (args.cells + args.grids + args.closed == 0) {
-        throw UsageError("nothing to do: give --cells N, --grids N and/or --closed N "
+    if (args.cells + args.grids + args.closed + args.ties == 0) {
+        throw UsageError("nothing to do: give --cells N, --grids N, --closed N and/or --ties N "
                          "(e.g. --cells 20000 --grids 5000), or --dataset DIR");
     }
     const int min_size = args.closed > 0 ? 3 : 2;
@@ -238,6 +242,7 @@ void run_verify(const VerifyArgs& args, const std::string& failures_default)
         options.cells = args.cells;
         options.grids = args.grids;
         options.closed = args.closed;
+        options.ties = args.ties;
         options.size = args.size;
         options.seed = args.seed;
         options.threads = args.threads;
@@ -305,6 +310,12 @@ void add_verify(CLI::App& app)
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--closed", args->closed, "Random grids whose surfaces are all closed")
+            ->type_name("N")
+            ->check(CLI::NonNegativeNumber)
+            ->group(random_group));
+    args->random_only.push_back(
+        cmd->add_option("--ties", args->ties,
+                        "Random grids of integers -2..2 or -3..3 at iso 0: ties everywhere")
             ->type_name("N")
             ->check(CLI::NonNegativeNumber)
             ->group(random_group));

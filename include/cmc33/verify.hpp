@@ -25,12 +25,15 @@ namespace cmc33 {
 ///            and all 33 subcases (docs/verification.md lists them);
 ///  - grid:   size^3 samples uniform in [-1, 1] (the paper's 5x5x5 grids);
 ///  - closed: size^3 samples, those with an index 0 or size - 1 in [-1, -0.1] (below iso 0, so
-///            every surface is closed), the others uniform in [-1, 1].
+///            every surface is closed), the others uniform in [-1, 1];
+///  - ties:   size^3 integer samples, odd items uniform in {-2, ..., 2}, even items in
+///            {-3, ..., 3} (integer data 0..4 at iso 2 and 0..6 at iso 3, shifted): samples equal
+///            to the isovalue everywhere, and face and interior saddles at it too.
 /// The isovalue is 0 for all of them.
-enum class FieldKind { cell, grid, closed };
-inline constexpr int kFieldKindCount = 3;
+enum class FieldKind { cell, grid, closed, ties };
+inline constexpr int kFieldKindCount = 4;
 
-std::string_view field_kind_name(FieldKind kind) noexcept; ///< "cell", "grid", "closed"
+std::string_view field_kind_name(FieldKind kind) noexcept; ///< "cell", "grid", "closed", "ties"
 
 /// Item n (n >= 1) of kind `kind` in a run with seed `seed`: float samples, spacing 1, origin 0.
 /// Each item has its own generator, seeded from (seed, kind, n) (SplitMix64), so a field does not
@@ -66,6 +69,7 @@ struct VerifyOptions {
     std::int64_t cells = 0;  ///< cell fields, items 1..cells
     std::int64_t grids = 0;  ///< grid fields
     std::int64_t closed = 0; ///< closed fields
+    std::int64_t ties = 0;   ///< tie fields
     int size = 5; ///< samples per axis of grid and closed fields, >= 2 (>= 3 with closed)
     std::uint64_t seed = 1;
     int threads = 0; ///< 0: all cores. Each extract() runs single-threaded.
@@ -81,11 +85,14 @@ struct MethodReport {
     Method method = Method::cmc33;
     bool external = false;         ///< an external command (verify_dataset)
     std::int64_t checked = 0;      ///< fields compared (determined ones)
-    std::int64_t matched = 0;      ///< invariants equal and manifold
+    std::int64_t matched = 0;      ///< invariants equal, manifold and embedded (also once welded)
     std::int64_t mismatched = 0;   ///< checked - matched (includes non-manifold and errors)
     std::int64_t undetermined = 0; ///< fields field_topology could not settle: not compared
     std::int64_t nonmanifold = 0;  ///< meshes with a non-manifold edge or vertex
     std::int64_t unoriented = 0;   ///< meshes not consistently oriented (reported, not a mismatch)
+    /// meshes not embedded in space (coincident vertices, zero-area or intersecting triangles:
+    /// mesh_geometry); each is a mismatch, as is a mesh whose topology changes once welded
+    std::int64_t not_embedded = 0;
     std::int64_t errors = 0;       ///< extract threw, or the command failed (also mismatched)
     std::array<std::int64_t, kFieldKindCount> checked_by_kind{};
     std::array<std::int64_t, kFieldKindCount> mismatched_by_kind{};
@@ -133,6 +140,7 @@ struct DatasetOptions {
     std::int64_t cells = 10000;
     std::int64_t grids = 10000;
     std::int64_t closed = 1000;
+    std::int64_t ties = 0;
     std::uint64_t seed = 1;
     int size = 5;
     int threads = 0;

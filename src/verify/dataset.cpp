@@ -41,7 +41,7 @@ using verification::detail::Tally;
 
 constexpr std::string_view kManifestHeader =
     "file\tiso\teuler\tb0\tb1\tb2\tboundary_loops\tsubcase";
-constexpr std::array<std::string_view, kFieldKindCount> kFolders = {"cells", "grids", "closed"};
+constexpr std::array<std::string_view, kFieldKindCount> kFolders = {"cells", "grids", "closed", "ties"};
 
 // README.txt of a dataset; @NAME@ fields are filled in by readme_text().
 constexpr std::string_view kReadme = R"(cmc33 verification dataset
@@ -56,6 +56,8 @@ whether an isosurface extractor is topologically correct (Etiene et al. 2012; Cu
   grids/   @GRIDS@ fields of @SIZE@ samples uniform in [-1, 1]
   closed/  @CLOSED@ fields of @SIZE@ samples whose boundary samples are in [-1, -0.1], so every
            surface is closed; the others uniform in [-1, 1]
+  ties/    @TIES@ fields of @SIZE@ integer samples in -2..2 or -3..3: samples, face saddles and
+           interior saddles equal to the isovalue (the sign rule below decides them)
 
 Every file is an NRRD volume (attached header, raw float32 in the byte order its header gives),
 x fastest, spacing 1. Fields whose topology the verifier could not decide are left out, so the
@@ -103,13 +105,16 @@ std::string readme_text(const DatasetOptions& options, const DatasetSummary& sum
         {"@CELLS@", std::to_string(summary.written[0])},
         {"@GRIDS@", std::to_string(summary.written[1])},
         {"@CLOSED@", std::to_string(summary.written[2])},
+        {"@TIES@", std::to_string(summary.written[3])},
         {"@SIZE@", cube},
         {"@LEFT_OUT@", std::to_string(summary.undetermined[0]) + " cells, " +
-                           std::to_string(summary.undetermined[1]) + " grids and " +
-                           std::to_string(summary.undetermined[2]) + " closed grids"},
+                           std::to_string(summary.undetermined[1]) + " grids, " +
+                           std::to_string(summary.undetermined[2]) + " closed grids and " +
+                           std::to_string(summary.undetermined[3]) + " tie grids"},
         {"@ARGS@", "--seed " + std::to_string(options.seed) + " --cells " +
                        std::to_string(options.cells) + " --grids " + std::to_string(options.grids) +
-                       " --closed " + std::to_string(options.closed) + " --size " + size},
+                       " --closed " + std::to_string(options.closed) + " --ties " + std::to_string(options.ties) +
+                       " --size " + size},
     };
     std::string text(kReadme);
     for (const auto& [key, value] : fields) {
@@ -288,6 +293,7 @@ FieldKind kind_of(const ManifestEntry& entry)
 {
     const std::string stem = std::filesystem::path(entry.file).filename().string();
     if (stem.rfind("closed", 0) == 0) return FieldKind::closed;
+    if (stem.rfind("ties", 0) == 0) return FieldKind::ties;
     if (entry.subcase != "-" || stem.rfind("cell", 0) == 0) return FieldKind::cell;
     return FieldKind::grid;
 }
@@ -365,11 +371,12 @@ std::string write_field(const std::filesystem::path& dir, FieldKind kind, std::i
 
 DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options)
 {
-    if (options.cells < 0 || options.grids < 0 || options.closed < 0) {
+    if (options.cells < 0 || options.grids < 0 || options.closed < 0 || options.ties < 0) {
         throw Error(Status::invalid_argument, "dataset: field counts must be >= 0; got cells " +
                                                   std::to_string(options.cells) + ", grids " +
                                                   std::to_string(options.grids) + ", closed " +
-                                                  std::to_string(options.closed));
+                                                  std::to_string(options.closed) + ", ties " +
+                                                  std::to_string(options.ties));
     }
     const int min_size = options.closed > 0 ? 3 : 2;
     if (options.size < min_size || options.size > 1024) {
@@ -389,8 +396,8 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
                         dir.string() + ": folder is not empty; expected a new or empty folder");
         }
     }
-    const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids,
-                                                           options.closed};
+    const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids, options.closed,
+                                                           options.ties};
     for (std::size_t k = 0; k < counts.size(); ++k) {
         if (counts[k] == 0) continue;
         const auto folder = dir / kFolders[k];
@@ -400,7 +407,7 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
                         folder.string() + ": cannot create the folder: " + ec.message());
         }
     }
-    const std::int64_t total = options.cells + options.grids + options.closed;
+    const std::int64_t total = options.cells + options.grids + options.closed + options.ties;
     const int threads = static_cast<int>(std::clamp<std::int64_t>(
         detail::resolve_threads(options.threads), 1, std::max<std::int64_t>(total, 1)));
     verification::detail::Ticker tick(options.progress, total, nullptr);

@@ -202,9 +202,11 @@ std::string_view field_kind_name(FieldKind kind) noexcept
     case FieldKind::grid:
         return "grid";
     case FieldKind::closed:
+        return "closed";
+    case FieldKind::ties:
         break;
     }
-    return "closed";
+    return "ties";
 }
 
 std::string_view cell_distribution_name(std::int64_t n) noexcept
@@ -245,8 +247,11 @@ Volume random_field(FieldKind kind, std::int64_t n, std::uint64_t seed, int size
             for (int i = 0; i < size; ++i) {
                 const bool boundary =
                     i == 0 || j == 0 || k == 0 || i == last || j == last || k == last;
-                const double value = kind == FieldKind::closed && boundary ? rng.uniform(-1, -0.1)
-                                                                           : rng.uniform(-1, 1);
+                double value = kind == FieldKind::closed && boundary ? rng.uniform(-1, -0.1) : rng.uniform(-1, 1);
+                if (kind == FieldKind::ties) {
+                    const unsigned half = n % 2 == 1 ? 2 : 3; // 0..4 at iso 2, 0..6 at iso 3
+                    value = static_cast<double>(rng.below(2 * half + 1)) - half;
+                }
                 *out++ = static_cast<float>(value);
             }
         }

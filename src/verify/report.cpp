@@ -26,6 +26,7 @@ void add(MethodReport& into, const MethodReport& from)
     into.undetermined += from.undetermined;
     into.nonmanifold += from.nonmanifold;
     into.unoriented += from.unoriented;
+    into.not_embedded += from.not_embedded;
     into.errors += from.errors;
     for (std::size_t k = 0; k < into.checked_by_kind.size(); ++k) {
         into.checked_by_kind[k] += from.checked_by_kind[k];
@@ -89,7 +90,17 @@ bool record(Tally& tally, Outcome&& outcome, int max_failures)
         const bool manifold = is_manifold(*got);
         if (!manifold) ++r.nonmanifold;
         if (got->faces > 0 && !got->oriented) ++r.unoriented;
-        ok = manifold && topology_matches(*got, *outcome.expected);
+        // In space too: embedded, and still right once welded by position (what users' tools do).
+        const MeshGeometry geometry = mesh_geometry(*outcome.mesh, MeshGeometryOptions{1, 1});
+        if (!geometry.embedded()) {
+            ++r.not_embedded;
+            if (!outcome.note.empty()) outcome.note += "; ";
+            outcome.note += "not embedded: " + std::to_string(geometry.coincident_vertices) + " coincident vertices, " +
+                            std::to_string(geometry.zero_area_triangles) + " zero-area triangles, " +
+                            std::to_string(geometry.intersecting_pairs) + " intersecting triangle pairs";
+        }
+        ok = manifold && topology_matches(*got, *outcome.expected) && geometry.embedded() &&
+             is_manifold(geometry.welded) && topology_matches(geometry.welded, *outcome.expected);
     }
     if (ok) {
         ++r.matched;

@@ -43,13 +43,14 @@ void check_options(const VerifyOptions& options)
     auto bad = [](const std::string& what) {
         throw Error(Status::invalid_argument, "verify: " + what);
     };
-    if (options.cells < 0 || options.grids < 0 || options.closed < 0) {
+    if (options.cells < 0 || options.grids < 0 || options.closed < 0 || options.ties < 0) {
         bad("field counts must be >= 0; got cells " + std::to_string(options.cells) + ", grids " +
-            std::to_string(options.grids) + ", closed " + std::to_string(options.closed));
+            std::to_string(options.grids) + ", closed " + std::to_string(options.closed) + ", ties " +
+            std::to_string(options.ties));
     }
     verification::detail::check_methods(options.methods);
     const int min_size = options.closed > 0 ? 3 : 2;
-    if ((options.grids > 0 || options.closed > 0) &&
+    if ((options.grids > 0 || options.closed > 0 || options.ties > 0) &&
         (options.size < min_size || options.size > 1024)) {
         bad("grid size " + std::to_string(options.size) + " is out of range; expected " +
             std::to_string(min_size) + " to 1024" +
@@ -116,9 +117,9 @@ void check_field(const VerifyOptions& options, FieldKind kind, std::int64_t n, s
 VerifyReport verify(const VerifyOptions& options)
 {
     check_options(options);
-    const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids,
-                                                           options.closed};
-    const std::int64_t total = options.cells + options.grids + options.closed;
+    const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids, options.closed,
+                                                           options.ties};
+    const std::int64_t total = options.cells + options.grids + options.closed + options.ties;
     const int threads = static_cast<int>(std::clamp<std::int64_t>(
         detail::resolve_threads(options.threads), 1, std::max<std::int64_t>(total, 1)));
     std::vector<std::vector<Tally>> tallies =

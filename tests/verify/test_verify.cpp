@@ -60,7 +60,7 @@ std::vector<std::int64_t> numbers(const VerifyReport& r)
     std::vector<std::int64_t> n(r.fields.begin(), r.fields.end());
     for (const MethodReport& m : r.methods) {
         n.insert(n.end(), {m.checked, m.matched, m.mismatched, m.undetermined, m.nonmanifold,
-                           m.unoriented, m.errors, m.failures_written});
+                           m.unoriented, m.not_embedded, m.errors, m.failures_written});
         n.insert(n.end(), m.checked_by_kind.begin(), m.checked_by_kind.end());
         n.insert(n.end(), m.mismatched_by_kind.begin(), m.mismatched_by_kind.end());
         n.insert(n.end(), m.fields_per_subcase.begin(), m.fields_per_subcase.end());
@@ -193,7 +193,7 @@ TEST(Verify, Cmc33MatchesEverywhereAndTheFlawedMethodsDoNot)
     const VerifyReport r = verify(o);
     EXPECT_EQ(last_done, 3700);
     EXPECT_GE(calls, 1);
-    EXPECT_EQ(r.fields, (std::array<std::int64_t, 3>{3000, 500, 200}));
+    EXPECT_EQ(r.fields, (std::array<std::int64_t, 4>{3000, 500, 200, 0}));
     EXPECT_EQ(r.threads, 2);
     ASSERT_EQ(r.methods.size(), 3u);
 
