@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -175,6 +176,82 @@ TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
             EXPECT_EQ(tf.faces, t.faces);
         }
     }
+}
+
+// Ties in space (docs/conventions.md, "Geometry"): every method's mesh is embedded, its vertices
+// keep at least delta = 2^-10 of an edge away from every sample, and welding by position changes
+// nothing.
+TEST(Extract, TiesAreEmbeddedAndStayOffTheSamples)
+{
+    std::mt19937_64 rng(11);
+    for (int trial = 0; trial < 30; ++trial) {
+        Volume v(cmc33::ScalarType::u8, {9, 8, 7}, {0.5, 1, 2}, {-3, 0, 10});
+        std::uint8_t* p = v.samples<std::uint8_t>();
+        for (std::int64_t i = 0; i < v.sample_count(); ++i) p[i] = static_cast<std::uint8_t>(78 + rng() % 5); // 78..82
+        for (Method m : kMethods) {
+            const cmc33::Mesh mesh = cmc33::extract(v, 80.0, {m});
+            const cmc33::MeshGeometry g = cmc33::mesh_geometry(mesh);
+            EXPECT_TRUE(g.embedded()) << g.coincident_vertices << " coincident, " << g.zero_area_triangles << " zero-area, "
+                                      << g.intersecting_pairs << " intersecting";
+            const auto t = cmc33::mesh_topology(mesh);
+            EXPECT_EQ(g.welded.euler, t.euler);
+            EXPECT_EQ(g.welded.components, t.components);
+            EXPECT_EQ(g.welded.nonmanifold_edges, 0);
+            for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
+                // grid coordinates; the distance to the nearest sample along each axis
+                const double x[3] = {(mesh.positions[3 * q] + 3.0) / 0.5, mesh.positions[3 * q + 1] / 1.0,
+                                     (mesh.positions[3 * q + 2] - 10.0) / 2.0};
+                double off = 0;
+                for (double c : x) off = std::max(off, std::fabs(c - std::round(c)));
+                ASSERT_GE(off, 0x1p-10 * 0.999) << "vertex " << q << " sits on a sample";
+            }
+        }
+    }
+}
+
+// A sample exactly at the isovalue whose neighbours are all below is a component of its own (the
+// sign rule counts it as above): a closed surface around it, delta of an edge away, not a point.
+TEST(Extract, ABumpExactlyAtTheIsovalueIsATinyClosedSurface)
+{
+    Volume v(cmc33::ScalarType::u8, {3, 3, 3});
+    std::uint8_t* p = v.samples<std::uint8_t>();
+    for (std::int64_t i = 0; i < 27; ++i) p[i] = 60;
+    p[13] = 80; // the centre
+    const cmc33::Mesh mesh = cmc33::extract(v, 80.0);
+    expect_closed_manifold(mesh, 2, 1);
+    EXPECT_EQ(mesh.vertex_count(), 6u);
+    for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
+        double d = 0;
+        for (int c = 0; c < 3; ++c) d += std::fabs(mesh.positions[3 * q + static_cast<std::size_t>(c)] - 1.0);
+        EXPECT_DOUBLE_EQ(d, 0x1p-10);
+    }
+    EXPECT_TRUE(cmc33::mesh_geometry(mesh).embedded());
+    const cmc33::FieldTopology f = cmc33::field_topology(v, 80.0);
+    EXPECT_EQ(f.b0, 1);
+    EXPECT_EQ(f.euler, 2);
+}
+
+// Tunnels on random grids: every tube is embedded, whatever the crossings (here pushed to the ends
+// of their edges by values of very different magnitudes).
+TEST(Extract, TubesAreEmbeddedForExtremeCrossings)
+{
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::int64_t tubes = 0;
+    for (int trial = 0; trial < 400; ++trial) {
+        const Volume v = cmc33::test::make_volume({5, 5, 5}, [&](auto, auto, auto) {
+            const double x = u(rng);
+            return (x < 0 ? -1 : 1) * std::pow(10.0, -5 * std::fabs(u(rng)));
+        });
+        cmc33::ExtractStats stats;
+        const cmc33::Mesh mesh = cmc33::extract(v, 0.0, {}, &stats);
+        for (const char* name : {"4.1.2", "6.1.2", "7.4.2", "10.1.2", "12.1.2", "13.5.2"})
+            for (int s = 0; s < cmc33::kSubcaseCount; ++s)
+                if (cmc33::subcase_name(s) == name) tubes += stats.cells_per_subcase[static_cast<std::size_t>(s)];
+        const cmc33::MeshGeometry g = cmc33::mesh_geometry(mesh);
+        ASSERT_TRUE(g.embedded()) << "trial " << trial << ": " << g.intersecting_pairs << " intersecting pairs";
+    }
+    EXPECT_GT(tubes, 100);
 }
 
 TEST(Extract, TypedAndStridedViewsGiveTheSameMesh)

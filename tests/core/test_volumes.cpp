@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <ostream>
 #include <string>
 #include <utility>
@@ -95,6 +96,25 @@ TEST_P(RealVolume, ManifoldOrientedBoundaryOnlyOnTheBox)
         EXPECT_EQ(t.b1, field.b1);
         EXPECT_EQ(t.closed_components, field.b2);
         EXPECT_EQ(t.boundary_loops, field.boundary_loops);
+        // in space: embedded (no coincident vertices, zero-area or intersecting triangles), so the
+        // STL round trip (triangles without shared vertices, welded by position when read back)
+        // gives the same manifold with the same invariants
+        const cmc33::MeshGeometry g = cmc33::mesh_geometry(mesh);
+        EXPECT_EQ(g.coincident_vertices, 0);
+        EXPECT_EQ(g.zero_area_triangles, 0);
+        EXPECT_EQ(g.intersecting_pairs, 0);
+        const auto stl = cmc33::test::temp_dir() / (std::string(GetParam().file) + ".stl");
+        cmc33::io::write_mesh(mesh, stl);
+        const cmc33::MeshTopology w = cmc33::mesh_topology(cmc33::io::read_mesh(stl));
+        std::filesystem::remove(stl);
+        EXPECT_EQ(w.nonmanifold_edges, 0);
+        EXPECT_EQ(w.nonmanifold_vertices, 0);
+        EXPECT_EQ(w.degenerate_triangles, 0);
+        EXPECT_EQ(w.euler, field.euler);
+        EXPECT_EQ(w.components, field.b0);
+        EXPECT_EQ(w.b1, field.b1);
+        EXPECT_EQ(w.closed_components, field.b2);
+        EXPECT_EQ(w.boundary_loops, field.boundary_loops);
     }
 }
 
