@@ -3,7 +3,7 @@
 # grids with all three methods, using the Release build. Saves the JSON report and a markdown
 # summary (date, seed, machine, per-method results, mismatches per subcase) and prints their names.
 #
-# Usage: scripts/long_verify.sh [SEED] [--cells N] [--grids N] [--closed N] [--size N]
+# Usage: scripts/long_verify.sh [SEED] [--cells N] [--grids N] [--closed N] [--ties N] [--size N]
 #                               [--threads N] [--out DIR] [--build DIR | --exe PATH]
 #   SEED     default: today's date as YYYYMMDD
 #   --out    folder for the reports (default verify-results/); failing fields go to a folder
@@ -25,6 +25,7 @@ seed=$(date +%Y%m%d)
 cells=1000000
 grids=100000
 closed=10000
+ties=10000
 size=5
 threads=0
 out=verify-results
@@ -35,6 +36,7 @@ while [ $# -gt 0 ]; do
     --cells) cells=${2:?}; shift 2 ;;
     --grids) grids=${2:?}; shift 2 ;;
     --closed) closed=${2:?}; shift 2 ;;
+    --ties) ties=${2:?}; shift 2 ;;
     --size) size=${2:?}; shift 2 ;;
     --threads) threads=${2:?}; shift 2 ;;
     --out) out=${2:?}; shift 2 ;;
@@ -75,9 +77,9 @@ machine="$(lscpu 2>/dev/null | sed -n 's/^Model name:[[:space:]]*//p' | head -n 
 commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
 if ! git diff --quiet HEAD 2>/dev/null; then commit="$commit (with local changes)"; fi
 
-echo "long_verify.sh: seed $seed, $cells cells, $grids grids, $closed closed grids (${size}^3), machine: $machine" >&2
+echo "long_verify.sh: seed $seed, $cells cells, $grids grids, $closed closed grids, $ties tie grids (${size}^3), machine: $machine" >&2
 status=0
-"$cmc33" verify --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --size "$size" \
+"$cmc33" verify --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --ties "$ties" --size "$size" \
     --threads "$threads" --failures "$failures" --json --progress >"$json" || status=$?
 if [ "$status" -gt 1 ]; then
     echo "long_verify.sh: cmc33 verify failed with status $status" >&2
@@ -93,22 +95,23 @@ rates = r["fields_per_second"]
 lines = [
     "# cmc33 long verification, %s" % day,
     "",
-    "- seed %d; %d cells, %d grids and %d closed grids of %d^3 samples; isovalue 0"
-    % (r["seed"], f["cell"], f["grid"], f["closed"], r["size"]),
+    "- seed %d; %d cells, %d grids, %d closed grids and %d tie grids of %d^3 samples; isovalue 0"
+    % (r["seed"], f["cell"], f["grid"], f["closed"], f["ties"], r["size"]),
     "- machine: %s; %d threads; commit %s" % (machine, r["threads"], commit),
-    "- time: %.1f s (cells %.0f/s, grids %.0f/s, closed %.0f/s, all methods together)"
-    % (r["seconds"], rates["cell"], rates["grid"], rates["closed"]),
-    "- reproduce: `cmc33 verify --seed %d --cells %d --grids %d --closed %d --size %d`"
-    % (r["seed"], f["cell"], f["grid"], f["closed"], r["size"]),
+    "- time: %.1f s (cells %.0f/s, grids %.0f/s, closed %.0f/s, ties %.0f/s, all methods together)"
+    % (r["seconds"], rates["cell"], rates["grid"], rates["closed"], rates["ties"]),
+    "- reproduce: `cmc33 verify --seed %d --cells %d --grids %d --closed %d --ties %d --size %d`"
+    % (r["seed"], f["cell"], f["grid"], f["closed"], f["ties"], r["size"]),
     "",
-    "| method | checked | matched | mismatched | undetermined | non-manifold | unoriented | errors | mismatched cells / grids / closed |",
-    "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    "| method | checked | matched | mismatched | undetermined | non-manifold | not embedded | unoriented | errors | mismatched cells / grids / closed / ties |",
+    "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
 ]
 for m in r["methods"]:
     k = m["by_kind"]
-    lines.append("| %s | %d | %d | %d | %d | %d | %d | %d | %d / %d / %d |" % (
+    lines.append("| %s | %d | %d | %d | %d | %d | %d | %d | %d | %d / %d / %d / %d |" % (
         m["method"], m["checked"], m["matched"], m["mismatched"], m["undetermined"], m["nonmanifold"],
-        m["unoriented"], m["errors"], k["cell"]["mismatched"], k["grid"]["mismatched"], k["closed"]["mismatched"]))
+        m["not_embedded"], m["unoriented"], m["errors"], k["cell"]["mismatched"], k["grid"]["mismatched"],
+        k["closed"]["mismatched"], k["ties"]["mismatched"]))
 order = ["0", "1", "2", "3.1", "3.2", "4.1.1", "4.1.2", "5", "6.1.1", "6.1.2", "6.2", "7.1", "7.2", "7.3",
          "7.4.1", "7.4.2", "8", "9", "10.1.1", "10.1.2", "10.2", "11", "12.1.1", "12.1.2", "12.2", "12.3",
          "13.1", "13.2", "13.3", "13.4", "13.5.1", "13.5.2", "14"]
