@@ -29,6 +29,7 @@
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
 #include "core/parallel.hpp"
+#include "io/atomic_file.hpp"
 #include "verify/verify_detail.hpp"
 
 namespace cmc33 {
@@ -206,27 +207,28 @@ int subcase_index(std::string_view name)
     return -1;
 }
 
-/// Removes the temporary folder of the external command's outputs.
+/// The temporary folder of the external command's outputs, registered so that a signal removes
+/// it too (io/atomic_file.hpp); the destructor removes it.
 struct TempFolder {
     std::filesystem::path path;
-    TempFolder()
+    io::detail::Temporary temp;
+    TempFolder() : path(fresh_path()), temp(path, [this] { create(); }) {}
+
+private:
+    static std::filesystem::path fresh_path()
     {
         const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-        path = std::filesystem::temp_directory_path() /
+        return std::filesystem::temp_directory_path() /
                ("cmc33-verify-" + std::to_string(::getpid()) + "-" + std::to_string(stamp));
+    }
+    void create() const
+    {
         std::error_code ec;
         std::filesystem::create_directories(path, ec);
         if (ec)
             throw Error(Status::io_error,
                         path.string() + ": cannot create a temporary folder: " + ec.message());
     }
-    ~TempFolder()
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    TempFolder(const TempFolder&) = delete;
-    TempFolder& operator=(const TempFolder&) = delete;
 };
 
 std::string last_line(const std::filesystem::path& log)
