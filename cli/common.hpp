@@ -102,9 +102,11 @@ Json topology_json(const MeshTopology& topology);
 void print_json(const Json& json);
 
 /// If `output` is not empty: throws, before any work is done, what write_mesh would throw for
-/// it (unknown extension: the library's Error; a missing directory: Error{io_error}) and a
-/// UsageError for --ascii with anything but .ply.
-void check_mesh_output(const std::string& output, bool ascii);
+/// it (unknown extension: the library's Error; a missing or non-writable directory:
+/// Error{io_error}), and a UsageError for --ascii with anything but .ply, for --normals
+/// (`normals`) with .off or .stl, and for an output that is one of `inputs`.
+void check_mesh_output(const std::string& output, bool ascii, bool normals = false,
+                       const std::vector<std::string>& inputs = {});
 
 /// "1234" for rates of 100 and more, else 3 significant digits.
 std::string rate_text(double per_second);
