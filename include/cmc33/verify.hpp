@@ -148,9 +148,12 @@ struct DatasetSummary {
 /// Writes `dir/cells/cell-000001.nrrd`, `dir/grids/grid-000001.nrrd`, `dir/closed/...` (float
 /// NRRD; the same fields verify() draws with the same seed), `dir/manifest.tsv` and
 /// `dir/README.txt`. Fields whose topology is undetermined are left out (their numbers are
-/// skipped). `dir` is created; it must not exist or be empty.
-/// @throws Error{invalid_argument} if dir holds files, for a negative count or a bad size;
-///         Error{io_error} from the writers.
+/// skipped). `dir` is created if it does not exist; else it must be empty or hold a previous
+/// dataset and nothing else (manifest.tsv, README.txt and the files the manifest lists), which is
+/// replaced. The files are written into the hidden folder `dir/.cmc33-dataset-tmpPID/` and moved
+/// into place at the end: on an error nothing is left (and `dir` is removed if it was created).
+/// @throws Error{invalid_argument} if dir is empty (""), not a folder or holds other files, for a
+///         negative count or a bad size; Error{io_error} from the writers.
 DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options);
 
 /// One line of manifest.tsv.
