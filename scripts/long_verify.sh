@@ -77,7 +77,7 @@ if ! git diff --quiet HEAD 2>/dev/null; then commit="$commit (with local changes
 
 echo "long_verify.sh: seed $seed, $cells cells, $grids grids, $closed closed grids (${size}^3), machine: $machine" >&2
 status=0
-"$cmc33" verify --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --size "$size" \
+"$cmc33" verify --method all --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --size "$size" \
     --threads "$threads" --failures "$failures" --json --progress >"$json" || status=$?
 if [ "$status" -gt 1 ]; then
     echo "long_verify.sh: cmc33 verify failed with status $status" >&2

@@ -95,6 +95,9 @@ struct MethodReport {
     std::array<std::int64_t, kSubcaseCount> fields_per_subcase{};
     std::array<std::int64_t, kSubcaseCount> mismatches_per_subcase{};
     std::int64_t failures_written = 0; ///< failing fields saved for this method
+    /// "cell-000001: why": the first field (in run order) that gave no mesh, among the
+    /// max_failures kept; "" if none. Set whether or not failures are written.
+    std::string first_error;
 };
 
 struct VerifyReport {
@@ -176,6 +179,9 @@ struct DatasetVerifyOptions {
     /// the template writes an extension right after it ("{out}.obj", ".off", ".ply", ".stl"), in
     /// which case {out} is the path without extension. Paths are single-quoted for the shell.
     std::string command;
+    /// The command is killed (its whole process group) after this many seconds on one file; the
+    /// file then counts as an error. <= 0: no limit.
+    double timeout_seconds = 60;
     int threads = 0;
     std::filesystem::path failures_dir; ///< as in VerifyOptions
     int max_failures = 20;
@@ -183,7 +189,7 @@ struct DatasetVerifyOptions {
 };
 
 /// Checks every manifest entry: extracts it (in-process, or by running the command with
-/// std::system and reading its mesh with io::read_mesh) and compares with the manifest's
+/// /bin/sh -c in a process group of its own and reading its mesh with io::read_mesh) and compares with the manifest's
 /// invariants. A command that exits non-zero or writes no readable mesh counts as a mismatch
 /// (MethodReport::errors; the reason is in failures.tsv). Subcases are counted as in verify()
 /// (a 2x2x2 field is a cell), under the method, or under cmc33 for a command. Kinds: a file named
@@ -193,7 +199,7 @@ VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerif
 
 /// A command line for one field, and the mesh file it writes.
 struct ExternalCommand {
-    std::string shell;            ///< for std::system
+    std::string shell;            ///< for /bin/sh -c
     std::filesystem::path output; ///< the mesh file the command is expected to write
 };
 

@@ -9,6 +9,7 @@
 #include <cctype>
 #include <charconv>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
@@ -252,23 +253,66 @@ struct CommandResult {
     std::string note; ///< why there is no mesh
 };
 
-CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log)
+/// Runs the shell line in its own process group, so that a timeout or a signal kills the whole
+/// tool (a shell may have started several processes). Returns the wait status, or -1 if it could
+/// not start; `timed_out` is set if it was killed after `timeout_seconds` (<= 0: no limit).
+int run_shell(const std::string& line, double timeout_seconds, bool& timed_out)
+{
+    timed_out = false;
+    const char* const argv[] = {"/bin/sh", "-c", line.c_str(), nullptr};
+    const pid_t pid = io::detail::start_child([&argv] {
+        // In the forked child: async-signal-safe calls only, then exec.
+        ::setpgid(0, 0);
+        sigset_t none;
+        sigemptyset(&none);
+        ::pthread_sigmask(SIG_SETMASK, &none, nullptr); // the CLI blocks SIGINT/SIGTERM/SIGHUP
+        ::execv(argv[0], const_cast<char* const*>(argv));
+    });
+    if (pid < 0) return -1;
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(timeout_seconds));
+    auto pause = std::chrono::microseconds(100); // most tools take milliseconds: poll often, then less
+    int status = 0;
+    for (;;) {
+        const pid_t r = ::waitpid(pid, &status, WNOHANG);
+        if (r == pid) break;
+        if (r < 0 && errno != EINTR) {
+            status = -1;
+            break;
+        }
+        if (timeout_seconds > 0 && std::chrono::steady_clock::now() >= deadline) {
+            ::kill(-pid, SIGKILL);
+            while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+            }
+            timed_out = true;
+            break;
+        }
+        std::this_thread::sleep_for(pause);
+        pause = std::min<std::chrono::microseconds>(pause * 2, std::chrono::milliseconds(20));
+    }
+    io::detail::forget_child(pid);
+    return status;
+}
+
+CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log,
+                          double timeout_seconds)
 {
     std::error_code ec;
     std::filesystem::remove(command.output, ec);
     const std::string line =
         "(" + command.shell + ") >" + shell_quote(log.string()) + " 2>&1 </dev/null";
-    const int status = std::system(line.c_str());
+    bool timed_out = false;
+    const int status = run_shell(line, timeout_seconds, timed_out);
     CommandResult result;
     if (status == -1) {
-        result.note = "could not start the command (std::system returned -1)";
+        result.note = "could not start the command (fork or wait failed)";
         return result;
     }
-    if (WIFSIGNALED(status)) {
-        if (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGQUIT) {
-            throw Error(Status::io_error, "verify: interrupted (the command was killed by signal " +
-                                              std::to_string(WTERMSIG(status)) + ")");
-        }
+    if (timed_out) {
+        result.note = "the command did not finish within " + number_text(timeout_seconds) +
+                      " s (--timeout) and was killed";
+    } else if (WIFSIGNALED(status)) {
         result.note = "the command was killed by signal " + std::to_string(WTERMSIG(status));
     } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
         result.note = "the command exited with status " + std::to_string(WEXITSTATUS(status));
@@ -326,7 +370,8 @@ void check_entry(const EntryCheck& check, const DatasetVerifyOptions& options,
         if (tally.report.external) {
             const ExternalCommand command = expand_command(options.command, path, entry.iso,
                                                            scratch.string() + "-" + outcome.name);
-            CommandResult result = run_command(command, scratch.string() + "-log.txt");
+            CommandResult result =
+                run_command(command, scratch.string() + "-log.txt", options.timeout_seconds);
             outcome.mesh = std::move(result.mesh);
             outcome.note = std::move(result.note);
             outcome.subcases = subcases_of(*volume, entry.iso, Method::cmc33, nullptr);
