@@ -201,6 +201,7 @@ void run_cell(const CellArgs& args)
         throw UsageError("cell takes 8 corner values, got " + std::to_string(args.values.size()));
     }
     const Method method = parse_method(args.method);
+    check_mesh_output(args.output, false);
     std::array<double, 8> values{};
     for (std::size_t c = 0; c < 8; ++c) values[c] = args.values[c];
     const CellReport report = analyze_cell(values, args.iso, method);
@@ -222,13 +223,16 @@ void add_cell(CLI::App& app)
     cmd->add_option("VALUES", args->values, "The 8 corner values, corner c = x | y<<1 | z<<2")
         ->expected(8)
         ->required()
-        ->type_name("V");
-    cmd->add_option("-i,--iso", args->iso, "Isovalue (default 0)");
+        ->type_name("V")
+        ->check(number_check());
+    cmd->add_option("-i,--iso", args->iso, "Isovalue (default 0)")->check(number_check());
     cmd->add_option("--method", args->method, "cmc33 (default), mc33-lewiner or mc")
         ->type_name("NAME")
         ->check(method_validator());
     cmd->add_flag("--json", args->json, "Print one JSON object");
-    cmd->add_option("-o,--output", args->output, "Write the cell's mesh: .ply .obj .stl .off")->type_name("OUT");
+    cmd->add_option("-o,--output", args->output, "Write the cell's mesh: .ply .obj .stl .off")
+        ->type_name("OUT")
+        ->check(non_empty("a mesh file name"));
     cmd->footer(
         "Takes the values at the 8 corners of one cell, in the order (0,0,0) (1,0,0) (0,1,0)\n"
         "(1,1,0) (0,0,1) (1,0,1) (0,1,1) (1,1,1), i.e. corner c = x | y<<1 | z<<2, and prints every\n"

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -59,31 +60,36 @@ void add_dataset(CLI::App& app)
     auto args = std::make_shared<DatasetArgs>();
     CLI::App* cmd = app.add_subcommand(
         "dataset", "Write the verification dataset: random fields and their expected topology");
-    cmd->add_option("OUT", args->output, "Folder to create (it must not exist or be empty)")
-        ->required();
+    cmd->add_option("OUT", args->output,
+                    "Folder to write: new, empty, or a previous dataset (then replaced)")
+        ->required()
+        ->check(non_empty("a folder name"));
     cmd->add_option("--cells", args->options.cells,
                     "Random single cells, 2x2x2 samples (default 10000)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()));
     cmd->add_option("--grids", args->options.grids,
                     "Random grids, samples uniform in [-1, 1] (default 10000)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()));
     cmd->add_option("--closed", args->options.closed,
                     "Random grids whose surfaces are all closed (default 1000)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()));
     cmd->add_option("--ties", args->options.ties,
                     "Random grids of integers -2..2 or -3..3 at iso 0, ties everywhere (default 0)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()));
     cmd->add_option("--size", args->options.size, "Samples per axis of the grids (default 5)")
-        ->type_name("N");
-    cmd->add_option("--seed", args->options.seed, "Seed of the random fields (default 1)")
-        ->type_name("S");
-    cmd->add_option("--threads", args->options.threads, "Worker threads, 0 = all cores (default 0)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(2, 1024));
+    cmd->add_option("--seed", args->options.seed, "Seed of the random fields (default 1)")
+        ->type_name("S")
+        ->check(unsigned_number());
+    cmd->add_option("--threads", args->options.threads,
+                    "Worker threads, 0 = all cores (default 0, at most 1024)")
+        ->type_name("N")
+        ->check(thread_count());
     cmd->add_flag("--progress", args->progress,
                   "Progress lines on stderr even when it is not a terminal");
     cmd->footer(
@@ -95,6 +101,9 @@ void add_dataset(CLI::App& app)
         "as above it). OUT/README.txt explains the columns. Fields whose topology cannot be "
         "settled\n"
         "are left out. The fields are those `cmc33 verify` draws with the same seed.\n"
+        "OUT must be new, empty, or hold a previous dataset and nothing else (it is then replaced).\n"
+        "The files are written into OUT/.cmc33-dataset-tmpPID/ and moved into place at the end:\n"
+        "a failure or a signal leaves nothing behind.\n"
         "\n"
         "Examples:\n"
         "  cmc33 dataset mc-data\n"

@@ -29,7 +29,7 @@ struct ExtractArgs {
     bool json = false;
     bool ascii = false;
     int repeat = 1;
-    bool topology = true;
+    bool no_topology = false;
     RawVolumeOptions raw;
 };
 
@@ -47,7 +47,7 @@ void run_extract(const ExtractArgs& args)
     options.normals = args.normals;
     options.threads = args.threads;
     // A bad -o must fail before minutes of work, not after.
-    check_mesh_output(args.output, args.ascii);
+    check_mesh_output(args.output, args.ascii, args.normals, {args.input});
 
     const Volume volume = load_volume(args.input, args.raw);
 
@@ -69,15 +69,16 @@ void run_extract(const ExtractArgs& args)
     const double seconds = median(runs);
     MeshTopology topology;
     MeshGeometry geometry;
-    if (args.topology) topology = mesh_topology(mesh);
-    if (args.topology && args.json) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
+    if (!args.no_topology) topology = mesh_topology(mesh);
+    if (!args.no_topology && args.json) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
     if (!args.output.empty()) io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii});
 
     const int threads = args.threads > 0 ? args.threads
                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     if (args.json) {
+        // Subcase "0" (no crossing) is left out: extract counts the cells the surface crosses.
         Json subcases = Json::object();
-        for (int s = 0; s < kSubcaseCount; ++s) {
+        for (int s = 1; s < kSubcaseCount; ++s) {
             subcases[std::string(subcase_name(s))] = stats.cells_per_subcase[static_cast<std::size_t>(s)];
         }
         Json out{{"input", volume_json(args.input, volume)},
@@ -90,8 +91,8 @@ void run_extract(const ExtractArgs& args)
                  {"runs_seconds", runs},
                  {"threads", threads},
                  {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
-                 {"topology", args.topology ? topology_json(topology) : Json(nullptr)},
-                 {"geometry", args.topology ? geometry_json(geometry) : Json(nullptr)},
+                 {"topology", !args.no_topology ? topology_json(topology) : Json(nullptr)},
+                 {"geometry", !args.no_topology && args.json ? geometry_json(geometry) : Json(nullptr)},
                  {"subcases", subcases}};
         print_json(out);
         return;
@@ -101,13 +102,13 @@ void run_extract(const ExtractArgs& args)
                        std::to_string(mesh.vertex_count()) + " vertices, " +
                        std::to_string(mesh.triangle_count()) + " triangles in " + sig(seconds, 3) + " s";
     if (args.repeat > 1) line += " (median of " + std::to_string(args.repeat) + ")";
-    if (args.topology) {
+    if (!args.no_topology) {
         line += "; euler " + std::to_string(topology.euler) + ", components " +
                 std::to_string(topology.components) + ", boundary edges " +
                 std::to_string(topology.boundary_edges) + ", non-manifold edges " +
                 std::to_string(topology.nonmanifold_edges);
     }
-    if (args.topology && topology.nonmanifold_vertices != 0) {
+    if (!args.no_topology && topology.nonmanifold_vertices != 0) {
         line += ", non-manifold vertices " + std::to_string(topology.nonmanifold_vertices);
     }
     if (!args.output.empty()) line += " (" + args.output + ")";
@@ -121,23 +122,27 @@ void add_extract(CLI::App& app)
     auto args = std::make_shared<ExtractArgs>();
     CLI::App* cmd = app.add_subcommand("extract", "Extract the isosurface f = ISO of a volume as a triangle mesh");
     cmd->add_option("INPUT", args->input, "Volume: .nrrd .nhdr .mhd .mha .vtk, or headerless raw with --dims/--type")
-        ->required();
-    cmd->add_option("-i,--iso", args->iso, "Isovalue (a sample equal to it counts as above)")->required();
+        ->required()
+        ->check(non_empty("a volume file"));
+    cmd->add_option("-i,--iso", args->iso, "Isovalue (a sample equal to it counts as above)")
+        ->required()
+        ->check(number_check());
     cmd->add_option("-o,--output", args->output, "Write the mesh: .ply .obj .stl .off (by extension)")
-        ->type_name("OUT");
+        ->type_name("OUT")
+        ->check(non_empty("a mesh file name"));
     cmd->add_option("--method", args->method, "cmc33 (default), mc33-lewiner or mc")
         ->type_name("NAME")
         ->check(method_validator());
-    cmd->add_flag("--normals", args->normals, "Per-vertex normals from the field's gradient");
-    cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0)")
+    cmd->add_flag("--normals", args->normals, "Per-vertex normals from the field's gradient (.ply and .obj only)");
+    cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0, at most 1024)")
         ->type_name("N")
-        ->check(CLI::Range(0, 4096));
+        ->check(thread_count());
     cmd->add_flag("--json", args->json, "Print one JSON object instead of the summary line");
     cmd->add_flag("--ascii", args->ascii, "ASCII PLY instead of binary (only with -o OUT.ply)");
     cmd->add_option("--repeat", args->repeat, "Extract N times and report the median time (default 1)")
         ->type_name("N")
-        ->check(CLI::Range(1, 1000000));
-    cmd->add_flag("!--no-topology", args->topology,
+        ->check(whole_number(1, 1000000));
+    cmd->add_flag("--no-topology", args->no_topology,
                   "Skip the mesh topology (saves time and about 24 bytes per triangle; JSON topology: null)");
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(

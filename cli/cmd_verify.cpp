@@ -2,11 +2,14 @@
 // (in-process, or of any extractor run as a command). docs/verification.md explains both.
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -43,22 +46,30 @@ struct VerifyArgs {
     int max_failures = 20;
     std::string dataset;
     std::string command;
+    double timeout = 60;
+    CLI::Option* timeout_option = nullptr;
     std::vector<CLI::Option*> random_only; ///< options that make no sense with --dataset
 };
 
 constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed", "ties"};
 
+/// --method NAME, repeated or comma-separated; "all" for the three. Default: cmc33 alone (the
+/// legacy methods fail by design, so a default run that includes them could never pass).
 std::vector<Method> parse_methods(const std::vector<std::string>& names)
 {
     std::vector<Method> methods;
     for (const std::string& name : names) {
+        if (name == "all") {
+            if (names.size() != 1) throw UsageError("--method all lists every method; give no other with it");
+            return {Method::cmc33, Method::mc33_lewiner, Method::mc};
+        }
         const Method m = parse_method(name);
         if (std::find(methods.begin(), methods.end(), m) != methods.end()) {
             throw UsageError("--method " + name + " is given twice");
         }
         methods.push_back(m);
     }
-    if (methods.empty()) methods = {Method::cmc33, Method::mc33_lewiner, Method::mc};
+    if (methods.empty()) methods = {Method::cmc33};
     return methods;
 }
 
@@ -106,6 +117,7 @@ Json report_json(const VerifyReport& r, const VerifyArgs& args)
                            {"unoriented", m.unoriented},
                            {"not_embedded", m.not_embedded},
                            {"errors", m.errors},
+                           {"first_error", m.first_error.empty() ? Json(nullptr) : Json(m.first_error)},
                            {"by_kind", by_kind},
                            {"subcases", subcases},
                            {"failures_written", m.failures_written}});
@@ -159,7 +171,9 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
     }
     for (const MethodReport& m : r.methods) {
         if (m.errors != 0)
-            std::cout << m.name << ": " << m.errors << " fields gave no mesh (see failures.tsv)\n";
+            std::cout << m.name << ": " << m.errors << " fields gave no mesh"
+                      << (m.first_error.empty() ? "" : "; the first, " + m.first_error)
+                      << (r.failures_dir.empty() ? "" : " (all in failures.tsv)") << '\n';
         if (m.unoriented != 0)
             std::cout << m.name << ": " << m.unoriented << " meshes not consistently oriented\n";
     }
@@ -195,8 +209,32 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
     }
 }
 
+/// Where failures will go must be usable before the run, not after it: a folder, or a path whose
+/// nearest existing ancestor is a writable folder; never the dataset checked.
+void check_failures_folder(const VerifyArgs& args)
+{
+    if (args.failures.empty()) return;
+    const std::filesystem::path dir(args.failures);
+    std::error_code ec;
+    if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec)) {
+        throw Error(Status::io_error, args.failures + ": --failures exists and is not a folder");
+    }
+    if (!args.dataset.empty() && std::filesystem::equivalent(dir, args.dataset, ec) && !ec) {
+        throw UsageError("--failures " + args.failures + " is the dataset folder; give another folder");
+    }
+    std::filesystem::path existing = std::filesystem::absolute(dir, ec);
+    while (!existing.empty() && !std::filesystem::exists(existing, ec) && existing.has_parent_path() &&
+           existing.parent_path() != existing) {
+        existing = existing.parent_path();
+    }
+    check_writable_folder(existing, args.failures);
+}
+
 void check_usage(const VerifyArgs& args)
 {
+    if (args.timeout_option->count() > 0 && args.command.empty()) {
+        throw UsageError("--timeout limits each run of --cmd; give --dataset DIR --cmd TEMPLATE with it");
+    }
     if (!args.dataset.empty()) {
         for (const CLI::Option* o : args.random_only) {
             if (o->count() > 0) {
@@ -231,10 +269,11 @@ void check_usage(const VerifyArgs& args)
     }
 }
 
-void run_verify(const VerifyArgs& args, const std::string& failures_default)
+void run_verify(const VerifyArgs& args)
 {
     check_usage(args);
-    const std::filesystem::path failures = args.failures.empty() ? failures_default : args.failures;
+    check_failures_folder(args);
+    const std::filesystem::path failures = args.failures; // empty: none written
     VerifyReport report;
     if (args.dataset.empty()) {
         VerifyOptions options;
@@ -259,6 +298,7 @@ void run_verify(const VerifyArgs& args, const std::string& failures_default)
         DatasetVerifyOptions options;
         if (args.command.empty()) options.methods = parse_methods(args.methods);
         options.command = args.command;
+        options.timeout_seconds = args.timeout;
         options.threads = args.threads;
         options.failures_dir = failures;
         options.max_failures = args.max_failures;
@@ -283,8 +323,11 @@ void run_verify(const VerifyArgs& args, const std::string& failures_default)
                     " mismatched";
             if (m.nonmanifold != 0) what += " (" + std::to_string(m.nonmanifold) + " non-manifold)";
         }
-        if (!report.failures_dir.empty())
+        if (!report.failures_dir.empty()) {
             what += "; failures in " + report.failures_dir.string() + "/";
+        } else if (args.failures.empty()) {
+            what += "; rerun with --failures DIR to save the failing fields";
+        }
         throw VerificationFailed("verify: " + what);
     }
 }
@@ -301,56 +344,89 @@ void add_verify(CLI::App& app)
     args->random_only.push_back(
         cmd->add_option("--cells", args->cells, "Random single cells (2x2x2 samples)")
             ->type_name("N")
-            ->check(CLI::NonNegativeNumber)
+            ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()))
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--grids", args->grids, "Random grids, samples uniform in [-1, 1]")
             ->type_name("N")
-            ->check(CLI::NonNegativeNumber)
+            ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()))
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--closed", args->closed, "Random grids whose surfaces are all closed")
             ->type_name("N")
-            ->check(CLI::NonNegativeNumber)
+            ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()))
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--ties", args->ties,
                         "Random grids of integers -2..2 or -3..3 at iso 0: ties everywhere")
             ->type_name("N")
-            ->check(CLI::NonNegativeNumber)
+            ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()))
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--size", args->size, "Samples per axis of the grids (default 5)")
             ->type_name("N")
+            ->check(whole_number(2, 1024))
             ->group(random_group));
     args->random_only.push_back(
         cmd->add_option("--seed", args->seed, "Seed of the random fields (default 1)")
             ->type_name("S")
+            ->check(unsigned_number())
             ->group(random_group));
     cmd->add_option("--dataset", args->dataset,
                     "Check the files of a dataset written by `cmc33 dataset`")
         ->type_name("DIR")
+        ->check(non_empty("a dataset folder"))
         ->group("Dataset");
     cmd->add_option("--cmd", args->command,
                     "With --dataset: judge this extractor command instead, e.g.\n"
                     "'tool {in} {iso} {out}' ({out}: a .ply to write)")
         ->type_name("TEMPLATE")
+        ->check(non_empty("a command template"))
         ->group("Dataset");
-    cmd->add_option("--method", args->methods,
-                    "Method to check; repeat for several (default: all three)")
+    args->timeout_option =
+        cmd->add_option("--timeout", args->timeout,
+                        "With --cmd: seconds one run may take; then its process group is\n"
+                        "killed and the file counts as an error (default 60)")
+            ->type_name("SECONDS")
+            ->check(CLI::Validator(
+                [](std::string& text) -> std::string {
+                    char* end = nullptr;
+                    const double v = std::strtod(text.c_str(), &end);
+                    if (text.empty() || *end != '\0' || !std::isfinite(v) || v <= 0) {
+                        return "expected a number of seconds > 0, got '" + text + "'";
+                    }
+                    return {};
+                },
+                "> 0", "seconds"))
+            ->group("Dataset");
+    cmd->add_option("--method,--methods", args->methods,
+                    "Method to check: cmc33 (default), mc33-lewiner, mc, or all;\n"
+                    "repeat or separate with commas for several")
         ->type_name("NAME")
-        ->check(method_validator());
-    cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0)")
+        ->delimiter(',')
+        ->check(CLI::Validator(
+            [](std::string& name) -> std::string {
+                if (name == "all") return {};
+                try {
+                    (void)parse_method(name);
+                    return {};
+                } catch (const Error& e) {
+                    return std::string(e.what()) + " (or all)";
+                }
+            },
+            "cmc33|mc33-lewiner|mc|all", "method"));
+    cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0, at most 1024)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(thread_count());
     cmd->add_option("--failures", args->failures,
-                    "Folder for failing fields and meshes (default ./cmc33-failures,\n"
-                    "created only if something fails)")
-        ->type_name("DIR");
+                    "Save failing fields, meshes and failures.tsv in this folder\n"
+                    "(created only if something fails; default: none saved)")
+        ->type_name("DIR")
+        ->check(non_empty("a folder name"));
     cmd->add_option("--max-failures", args->max_failures,
                     "Failing fields saved per method (default 20)")
         ->type_name("N")
-        ->check(CLI::NonNegativeNumber);
+        ->check(whole_number(0, std::numeric_limits<int>::max()));
     cmd->add_flag("--json", args->json, "Print one JSON object instead of the tables");
     cmd->add_flag("--progress", args->progress,
                   "Progress lines on stderr even when it is not a terminal");
@@ -362,13 +438,16 @@ void add_verify(CLI::App& app)
         "and\n"
         "it has no non-manifold edge or vertex. Fields whose topology cannot be settled are "
         "counted\n"
-        "as undetermined. Failing fields are saved with the commands that reproduce them.\n"
+        "as undetermined. With --failures DIR, failing fields are saved with the commands that\n"
+        "reproduce them. The legacy methods (mc33-lewiner, mc) fail by design: they run only\n"
+        "when asked for (--method all, or --method mc,mc33-lewiner).\n"
         "Exit status: 0 all matched, 1 a mismatch or non-manifold mesh, 2 bad usage.\n"
         "\n"
         "Examples:\n"
-        "  cmc33 verify --method cmc33 --cells 20000 --grids 5000 --closed 1000\n"
-        "  cmc33 verify --dataset mc-data --cmd 'mytool {in} {iso} {out}'");
-    cmd->callback([args] { run_verify(*args, "cmc33-failures"); });
+        "  cmc33 verify --cells 200000 --grids 20000 --closed 5000\n"
+        "  cmc33 verify --method all --cells 20000 --grids 5000 --failures failed\n"
+        "  cmc33 verify --dataset mc-data --cmd 'mytool {in} {iso} {out}' --timeout 10");
+    cmd->callback([args] { run_verify(*args); });
 }
 
 } // namespace cmc33::cli

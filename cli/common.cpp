@@ -1,14 +1,18 @@
 #include "common.hpp"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <charconv>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -88,6 +92,7 @@ void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw)
                             ->group(group));
     raw.given.push_back(command.add_option("--header-bytes", raw.header_bytes, "Bytes to skip at the start of the file (default 0)")
                             ->type_name("N")
+                            ->check(unsigned_number())
                             ->group(group));
 }
 
@@ -136,6 +141,69 @@ CLI::Validator method_validator()
         },
         "cmc33|mc33-lewiner|mc", "method");
 }
+
+CLI::Validator number_check()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            // from_chars takes no '+' and no hex: "0x10" stops at 'x' and is refused.
+            const std::size_t skip = text.size() > 1 && text[0] == '+' && text[1] != '-' ? 1 : 0;
+            double v = 0;
+            const char* end = text.data() + text.size();
+            const auto [at, ec] = std::from_chars(text.data() + skip, end, v);
+            if (text.empty()) return "expected a number, got an empty value";
+            if (ec == std::errc::result_out_of_range && at == end) return "'" + text + "' is out of the range of a double";
+            if (ec != std::errc() || at != end) return "expected a number, got '" + text + "'";
+            return {};
+        },
+        "NUMBER", "number");
+}
+
+CLI::Validator whole_number(std::int64_t min, std::int64_t max)
+{
+    const std::string range = max == std::numeric_limits<std::int64_t>::max()
+                                  ? ">= " + std::to_string(min)
+                                  : "from " + std::to_string(min) + " to " + std::to_string(max);
+    return CLI::Validator(
+        [min, max, range](std::string& text) -> std::string {
+            std::int64_t n = 0;
+            const char* end = text.data() + text.size();
+            const auto [at, ec] = std::from_chars(text.data(), end, n);
+            if (text.empty()) return "expected a whole number " + range + ", got an empty value";
+            if (ec != std::errc() || at != end || n < min || n > max) {
+                return "expected a whole number " + range + ", got '" + text + "'";
+            }
+            return {};
+        },
+        "N " + range, "whole number");
+}
+
+CLI::Validator unsigned_number()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            std::uint64_t n = 0;
+            const char* end = text.data() + text.size();
+            const auto [at, ec] = std::from_chars(text.data(), end, n);
+            if (text.empty()) return "expected a whole number >= 0, got an empty value";
+            if (ec == std::errc::result_out_of_range) return "'" + text + "' does not fit in 64 bits";
+            if (ec != std::errc() || at != end) return "expected a whole number >= 0, got '" + text + "'";
+            return {};
+        },
+        "N >= 0", "unsigned whole number");
+}
+
+CLI::Validator non_empty(const std::string& what)
+{
+    return CLI::Validator(
+        [what](std::string& text) -> std::string {
+            if (text.empty()) return "expected " + what + ", got an empty value";
+            return {};
+        },
+        "", "non-empty");
+}
+
+CLI::Validator thread_count() { return whole_number(0, kMaxThreads); }
 
 namespace {
 
@@ -268,7 +336,36 @@ void print_json(const Json& json)
     std::cout << '\n';
 }
 
-void check_mesh_output(const std::string& output, bool ascii)
+void check_not_an_input(const std::string& output, const std::vector<std::string>& inputs)
+{
+    for (const std::string& input : inputs) {
+        std::error_code ec;
+        if (fs::equivalent(input, output, ec) && !ec) {
+            throw UsageError(output + " is the input " + (input == output ? "file" : input + " under another name") +
+                             "; write the output to another file, a command never replaces what it reads");
+        }
+    }
+}
+
+void check_writable_folder(const fs::path& dir, const std::string& output)
+{
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+        throw Error(Status::io_error, output + ": cannot write: the directory " + dir.string() + " does not exist");
+    }
+    // Try it: access(W_OK) says yes to root on a read-only file system.
+    const fs::path probe = dir / (".cmc33-probe-" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+    if (fd < 0) {
+        if (errno == EEXIST) return; // a file of ours, left by a process with the same pid: the folder is writable
+        throw Error(Status::io_error, output + ": cannot write: the directory " + dir.string() +
+                                          " is not writable (" + std::strerror(errno) + ")");
+    }
+    ::close(fd);
+    ::unlink(probe.c_str());
+}
+
+void check_mesh_output(const std::string& output, bool ascii, bool normals, const std::vector<std::string>& inputs)
 {
     if (output.empty()) {
         if (ascii) throw UsageError("--ascii needs -o OUT.ply");
@@ -283,12 +380,14 @@ void check_mesh_output(const std::string& output, bool ascii)
         throw Error(Status::unsupported_format, output + ": unsupported mesh extension; expected .ply, .obj, .stl or .off");
     }
     if (ascii && ext != ".ply") throw UsageError("--ascii is for .ply output only, not " + output);
+    if (normals && (ext == ".off" || ext == ".stl")) {
+        throw UsageError(output + ": OFF/STL cannot store normals; use .ply or .obj, or drop --normals");
+    }
+    check_not_an_input(output, inputs);
     const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw Error(Status::io_error, output + ": cannot write: it is a directory");
-    if (!fs::is_directory(dir, ec)) {
-        throw Error(Status::io_error, output + ": cannot write: the directory " + dir.string() + " does not exist");
-    }
+    check_writable_folder(dir, output);
 }
 
 void rethrow_naming(const Error& error, const std::string& path)

@@ -2,6 +2,7 @@
 // What the commands share: usage errors, the raw-volume options, number formatting, JSON helpers.
 
 #include <cstdint>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -48,6 +49,34 @@ Volume load_volume(const std::string& path, const RawVolumeOptions& raw);
 /// A CLI11 validator accepting the names cmc33::parse_method accepts.
 CLI::Validator method_validator();
 
+/// The whole text is one decimal number ("-3.5", "1e-3", "+2", "nan", "inf"; not "", "12abc",
+/// "0x10"): CLI11 alone reads "" as 0 and hex as a number. NaN and infinity pass: the library
+/// refuses them where they matter, naming the input.
+CLI::Validator number_check();
+/// The whole text is a whole number in [min, max] (message "expected a whole number from 0 to
+/// 1024, got '100000'"; ">= min" when max is the largest int64).
+CLI::Validator whole_number(std::int64_t min, std::int64_t max);
+/// A whole number >= 0 that fits 64 bits unsigned (--seed, --header-bytes).
+CLI::Validator unsigned_number();
+/// The value is not empty (an unset shell variable in `-o "$OUT"`).
+CLI::Validator non_empty(const std::string& what);
+
+/// --threads above this is refused before any work (the OS refuses such counts late, midway).
+inline constexpr std::int64_t kMaxThreads = 1024;
+/// --threads N: 0 (all cores) to kMaxThreads.
+CLI::Validator thread_count();
+
+/// Installs the cleanup of temporaries on SIGINT, SIGTERM and SIGHUP (cli/signals.cpp). Call
+/// first in main(), before any thread starts.
+void install_signal_cleanup();
+
+/// UsageError if `output` names the same file as one of `inputs` (also through a link or another
+/// spelling): a command must never overwrite what it reads.
+void check_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
+/// Error{io_error} naming the folder unless `dir` is an existing folder in which a file can be
+/// created (tried: root passes a permission test on a read-only file system).
+void check_writable_folder(const std::filesystem::path& dir, const std::string& output);
+
 /// Shortest decimal text that reads back as the same double: "80", "0.1", "1e-07", "nan".
 std::string num(double value);
 /// Same, for a float: 0.3f prints "0.3" (not the double expansion of the float).
@@ -76,9 +105,11 @@ Json geometry_json(const MeshGeometry& geometry);
 void print_json(const Json& json);
 
 /// If `output` is not empty: throws, before any work is done, what write_mesh would throw for
-/// it (unknown extension: the library's Error; a missing directory: Error{io_error}) and a
-/// UsageError for --ascii with anything but .ply.
-void check_mesh_output(const std::string& output, bool ascii);
+/// it (unknown extension: the library's Error; a missing or non-writable directory:
+/// Error{io_error}), and a UsageError for --ascii with anything but .ply, for --normals
+/// (`normals`) with .off or .stl, and for an output that is one of `inputs`.
+void check_mesh_output(const std::string& output, bool ascii, bool normals = false,
+                       const std::vector<std::string>& inputs = {});
 
 /// "1234" for rates of 100 and more, else 3 significant digits.
 std::string rate_text(double per_second);

@@ -1,7 +1,9 @@
 // cmc33: the command-line tool. Parses the line with CLI11, runs the one command given, and maps
 // every failure to one line on stderr and an exit code:
 //   0 success; 1 bad input or failure (cmc33::Error, unreadable file, non-finite sample, ...);
-//   2 bad usage (CLI11's parse errors and the commands' UsageError).
+//   2 bad usage (CLI11's parse errors and the commands' UsageError);
+//   128 + N killed by signal N among SIGINT (130), SIGTERM (143), SIGHUP (129), after removing
+//   its temporary files (cli/signals.cpp).
 
 #include <cstdio>
 #include <exception>
@@ -62,6 +64,7 @@ std::vector<std::string> arguments(int argc, char** argv)
 
 int main(int argc, char** argv)
 {
+    cmc33::cli::install_signal_cleanup(); // first: every thread started later inherits its signal mask
     CLI::App app("cmc33 " CMC33_VERSION_STRING ": extracts a topologically correct, manifold isosurface mesh\n"
                  "from a 3D scalar volume with Marching Cubes 33 (Custodio et al. 2013), and inspects\n"
                  "volumes, meshes and single cells.",
@@ -70,7 +73,8 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     app.allow_extras(false);
     app.footer("Run `cmc33 COMMAND --help` for a command's options and an example.\n"
-               "Exit codes: 0 success, 1 bad input or failure, 2 bad usage.\n"
+               "Exit codes: 0 success, 1 bad input or failure, 2 bad usage,\n"
+               "130/143/129 interrupted by SIGINT/SIGTERM/SIGHUP (temporary files removed).\n"
                "Example:\n"
                "  cmc33 extract head.nrrd --iso 80 -o head.ply");
     app.get_formatter()->column_width(36);

@@ -79,7 +79,7 @@ if ! git diff --quiet HEAD 2>/dev/null; then commit="$commit (with local changes
 
 echo "long_verify.sh: seed $seed, $cells cells, $grids grids, $closed closed grids, $ties tie grids (${size}^3), machine: $machine" >&2
 status=0
-"$cmc33" verify --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --ties "$ties" --size "$size" \
+"$cmc33" verify --method all --seed "$seed" --cells "$cells" --grids "$grids" --closed "$closed" --ties "$ties" --size "$size" \
     --threads "$threads" --failures "$failures" --json --progress >"$json" || status=$?
 if [ "$status" -gt 1 ]; then
     echo "long_verify.sh: cmc33 verify failed with status $status" >&2

@@ -30,7 +30,7 @@ struct MeshTopology {
     std::int64_t nonmanifold_vertices = 0; ///< vertices whose triangles form more than one fan
     std::int64_t degenerate_triangles = 0; ///< triangles that repeat a vertex index
     bool closed = false;   ///< no boundary edge (and at least one triangle)
-    bool oriented = false; ///< every edge with two triangles is used once in each direction
+    bool oriented = false; ///< every edge with two triangles is used once in each direction (true without triangles)
 };
 
 /// @throws Error{invalid_argument} if an index is not below the vertex count or the triangle array

@@ -102,6 +102,9 @@ struct MethodReport {
     std::array<std::int64_t, kSubcaseCount> fields_per_subcase{};
     std::array<std::int64_t, kSubcaseCount> mismatches_per_subcase{};
     std::int64_t failures_written = 0; ///< failing fields saved for this method
+    /// "cell-000001: why": the first field (in run order) that gave no mesh, among the
+    /// max_failures kept; "" if none. Set whether or not failures are written.
+    std::string first_error;
 };
 
 struct VerifyReport {
@@ -156,9 +159,12 @@ struct DatasetSummary {
 /// Writes `dir/cells/cell-000001.nrrd`, `dir/grids/grid-000001.nrrd`, `dir/closed/...` (float
 /// NRRD; the same fields verify() draws with the same seed), `dir/manifest.tsv` and
 /// `dir/README.txt`. Fields whose topology is undetermined are left out (their numbers are
-/// skipped). `dir` is created; it must not exist or be empty.
-/// @throws Error{invalid_argument} if dir holds files, for a negative count or a bad size;
-///         Error{io_error} from the writers.
+/// skipped). `dir` is created if it does not exist; else it must be empty or hold a previous
+/// dataset and nothing else (manifest.tsv, README.txt and the files the manifest lists), which is
+/// replaced. The files are written into the hidden folder `dir/.cmc33-dataset-tmpPID/` and moved
+/// into place at the end: on an error nothing is left (and `dir` is removed if it was created).
+/// @throws Error{invalid_argument} if dir is empty (""), not a folder or holds other files, for a
+///         negative count or a bad size; Error{io_error} from the writers.
 DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options);
 
 /// One line of manifest.tsv.
@@ -181,6 +187,9 @@ struct DatasetVerifyOptions {
     /// the template writes an extension right after it ("{out}.obj", ".off", ".ply", ".stl"), in
     /// which case {out} is the path without extension. Paths are single-quoted for the shell.
     std::string command;
+    /// The command is killed (its whole process group) after this many seconds on one file; the
+    /// file then counts as an error. <= 0: no limit.
+    double timeout_seconds = 60;
     int threads = 0;
     std::filesystem::path failures_dir; ///< as in VerifyOptions
     int max_failures = 20;
@@ -188,7 +197,7 @@ struct DatasetVerifyOptions {
 };
 
 /// Checks every manifest entry: extracts it (in-process, or by running the command with
-/// std::system and reading its mesh with io::read_mesh) and compares with the manifest's
+/// /bin/sh -c in a process group of its own and reading its mesh with io::read_mesh) and compares with the manifest's
 /// invariants. A command that exits non-zero or writes no readable mesh counts as a mismatch
 /// (MethodReport::errors; the reason is in failures.tsv). Subcases are counted as in verify()
 /// (a 2x2x2 field is a cell), under the method, or under cmc33 for a command. Kinds: a file named
@@ -198,7 +207,7 @@ VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerif
 
 /// A command line for one field, and the mesh file it writes.
 struct ExternalCommand {
-    std::string shell;            ///< for std::system
+    std::string shell;            ///< for /bin/sh -c
     std::filesystem::path output; ///< the mesh file the command is expected to write
 };
 

@@ -2,14 +2,130 @@
 
 #include <atomic>
 #include <cctype>
+#include <cerrno>
+#include <csignal>
 #include <fstream>
+#include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cmc33/error.hpp"
 
 namespace cmc33::io::detail {
+
+namespace {
+
+/// The temporaries and child process groups of the process (see atomic_file.hpp).
+struct Registry {
+    std::mutex mutex;
+    std::vector<std::pair<std::uint64_t, std::filesystem::path>> paths;
+    std::vector<pid_t> children;
+    std::uint64_t next_id = 1;
+};
+
+/// Never destroyed: a signal may arrive while static objects are destroyed at exit.
+Registry& registry()
+{
+    static Registry* const r = new Registry;
+    return *r;
+}
+
+void unregister(Registry& r, std::uint64_t id)
+{
+    for (auto it = r.paths.begin(); it != r.paths.end(); ++it) {
+        if (it->first == id) {
+            r.paths.erase(it);
+            return;
+        }
+    }
+}
+
+} // namespace
+
+Temporary::Temporary(std::filesystem::path path, const std::function<void()>& create) : path_(std::move(path))
+{
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    r.paths.reserve(r.paths.size() + 1); // registering after create() must not fail
+    create();
+    id_ = r.next_id++;
+    r.paths.emplace_back(id_, path_);
+}
+
+Temporary::~Temporary()
+{
+    if (committed_) return;
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+    unregister(r, id_);
+}
+
+void Temporary::commit(const std::function<void()>& finish)
+{
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    finish();
+    unregister(r, id_);
+    committed_ = true;
+}
+
+pid_t start_child(const std::function<void()>& child)
+{
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    r.children.reserve(r.children.size() + 1);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        child();
+        ::_exit(127);
+    }
+    if (pid > 0) {
+        ::setpgid(pid, pid); // the child does it too: whichever runs first, the group exists
+        r.children.push_back(pid);
+    }
+    return pid;
+}
+
+void forget_child(pid_t pid)
+{
+    Registry& r = registry();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    for (auto it = r.children.begin(); it != r.children.end(); ++it) {
+        if (*it == pid) {
+            r.children.erase(it);
+            return;
+        }
+    }
+}
+
+int remove_temporaries() noexcept
+{
+    Registry& r = registry();
+    r.mutex.lock(); // kept: nothing is registered between the cleanup and the exit
+    for (const pid_t pid : r.children) ::kill(-pid, SIGKILL);
+    for (const pid_t pid : r.children) {
+        // Wait until the child is dead (without reaping it: its own waitpid may be running), so
+        // that it writes nothing into a folder removed below.
+        siginfo_t info;
+        while (::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOWAIT) == -1 && errno == EINTR) {
+        }
+    }
+    int removed = 0;
+    for (const auto& entry : r.paths) {
+        try {
+            std::error_code ec;
+            if (std::filesystem::remove_all(entry.second, ec) > 0) ++removed;
+        } catch (...) { // bad_alloc: remove what can be removed
+        }
+    }
+    return removed;
+}
 
 void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write)
 {
@@ -25,21 +141,18 @@ void write_atomically(const std::filesystem::path& path, const std::function<voi
     std::string temp_name = ".";  // built piecewise: g++ 12 warns falsely on "." + string (-Wrestrict)
     temp_name += path.filename().string();
     temp_name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-    const std::filesystem::path temp = dir / temp_name;
-    try {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out) throw Error(Status::io_error, path.string() + ": cannot create a file in " + dir.string());
-        write(out);
-        out.flush();
-        if (!out) throw Error(Status::io_error, path.string() + ": writing failed (disk full?)");
-        out.close();
-        if (!out) throw Error(Status::io_error, path.string() + ": closing failed (disk full?)");
-        std::filesystem::rename(temp, path, ec);
+    std::ofstream out;
+    Temporary temp(dir / temp_name, [&] { out.open(dir / temp_name, std::ios::binary | std::ios::trunc); });
+    if (!out) throw Error(Status::io_error, path.string() + ": cannot create a file in " + dir.string());
+    write(out);
+    out.flush();
+    if (!out) throw Error(Status::io_error, path.string() + ": writing failed (disk full?)");
+    out.close();
+    if (!out) throw Error(Status::io_error, path.string() + ": closing failed (disk full?)");
+    temp.commit([&] {
+        std::filesystem::rename(temp.path(), path, ec);
         if (ec) throw Error(Status::io_error, path.string() + ": cannot rename the temporary file: " + ec.message());
-    } catch (...) {
-        std::filesystem::remove(temp, ec);
-        throw;
-    }
+    });
 }
 
 std::string lower_extension(const std::filesystem::path& path)

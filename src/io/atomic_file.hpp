@@ -2,19 +2,68 @@
 // Writing output files so that a failure never leaves a half-written file behind: the content
 // goes to a temporary file in the target's folder, which is renamed over the target only after
 // everything was written and flushed.
+//
+// An interrupted run must not leave them behind either. Every temporary (file or folder) and
+// every child process group the library starts is registered here while it exists, and
+// remove_temporaries() kills the groups and removes the paths. The CLI calls it from a thread
+// that waits for SIGINT, SIGTERM and SIGHUP with sigwait (cli/signals.cpp), not from a signal
+// handler: removing a folder tree is not async-signal-safe, and a normal thread may do anything.
+// Creating a temporary and registering it happen under the registry's lock, and so do the
+// rename that makes it final and its unregistering: a cleanup sees a temporary either whole or
+// not at all. After remove_temporaries() the lock stays taken, so no thread creates another
+// temporary before the process exits.
 
+#include <sys/types.h>
+
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <ostream>
+#include <string>
 
 namespace cmc33::io::detail {
 
 /// Calls write(stream) on a temporary file beside `path`, then renames it to `path`.
 /// If write throws, or the stream fails, the temporary file is removed and Error{io_error}
 /// (or write's own exception) propagates; `path` is left as it was.
+/// The temporary is `.NAME.tmpPID-N` in the target's folder (NAME the target's file name).
 void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
 
 /// Lower-case extension with the dot (".ply"); "" if none.
 std::string lower_extension(const std::filesystem::path& path);
+
+/// A registered temporary file or folder: remove_temporaries() removes it (recursively) until
+/// it is committed or destroyed. Destroying it removes it too, unless it was committed.
+class Temporary {
+public:
+    /// Runs create() (which makes `path`: opens the file, creates the folder) under the
+    /// registry's lock, then registers `path`. If create throws, nothing is registered.
+    Temporary(std::filesystem::path path, const std::function<void()>& create);
+    ~Temporary();
+    Temporary(const Temporary&) = delete;
+    Temporary& operator=(const Temporary&) = delete;
+
+    /// Runs finish() (the rename that makes the temporary final) under the registry's lock and
+    /// unregisters it; it is no longer removed. If finish throws, it stays registered.
+    void commit(const std::function<void()>& finish);
+    const std::filesystem::path& path() const noexcept { return path_; }
+
+private:
+    std::filesystem::path path_;
+    std::uint64_t id_ = 0;
+    bool committed_ = false;
+};
+
+/// Forks under the registry's lock, registers the child's process group (`child` runs in the
+/// forked child, must only call async-signal-safe functions and must not return: it puts
+/// itself in its own process group and execs). Returns the child's pid, -1 if fork failed.
+pid_t start_child(const std::function<void()>& child);
+/// The child has been waited for: its group is no longer killed by remove_temporaries().
+void forget_child(pid_t pid);
+
+/// Kills every registered process group (SIGKILL), removes every registered path, and keeps the
+/// registry locked so that nothing new is registered. For a thread that exits the process next.
+/// Returns the number of paths removed.
+int remove_temporaries() noexcept;
 
 } // namespace cmc33::io::detail

@@ -97,7 +97,10 @@ MeshTopology mesh_topology(const Mesh& mesh)
         ++faces;
     }
     result.faces = faces;
-    if (faces == 0) return result; // no vertex used: all counts 0, neither closed nor oriented
+    if (faces == 0) { // no vertex used: all counts 0; not closed, but trivially oriented (no edge)
+        result.oriented = true;
+        return result;
+    }
 
     for (std::size_t v = 0; v < n; ++v) {
         if (offsets[v + 1] != 0) ++result.vertices;

@@ -9,16 +9,20 @@
 #include <cctype>
 #include <charconv>
 #include <chrono>
+#include <cerrno>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <utility>
 #include <string>
 #include <system_error>
+#include <thread>
 #include <vector>
 
+#include <pthread.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -29,6 +33,7 @@
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
 #include "core/parallel.hpp"
+#include "io/atomic_file.hpp"
 #include "verify/verify_detail.hpp"
 
 namespace cmc33 {
@@ -42,6 +47,8 @@ using verification::detail::Tally;
 constexpr std::string_view kManifestHeader =
     "file\tiso\teuler\tb0\tb1\tb2\tboundary_loops\tsubcase";
 constexpr std::array<std::string_view, kFieldKindCount> kFolders = {"cells", "grids", "closed", "ties"};
+/// write_dataset writes into DIR/.cmc33-dataset-tmpPID/ and moves the result into DIR.
+constexpr std::string_view kTempPrefix = ".cmc33-dataset-tmp";
 
 // README.txt of a dataset; @NAME@ fields are filled in by readme_text().
 constexpr std::string_view kReadme = R"(cmc33 verification dataset
@@ -211,27 +218,28 @@ int subcase_index(std::string_view name)
     return -1;
 }
 
-/// Removes the temporary folder of the external command's outputs.
+/// The temporary folder of the external command's outputs, registered so that a signal removes
+/// it too (io/atomic_file.hpp); the destructor removes it.
 struct TempFolder {
     std::filesystem::path path;
-    TempFolder()
+    io::detail::Temporary temp;
+    TempFolder() : path(fresh_path()), temp(path, [this] { create(); }) {}
+
+private:
+    static std::filesystem::path fresh_path()
     {
         const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-        path = std::filesystem::temp_directory_path() /
+        return std::filesystem::temp_directory_path() /
                ("cmc33-verify-" + std::to_string(::getpid()) + "-" + std::to_string(stamp));
+    }
+    void create() const
+    {
         std::error_code ec;
         std::filesystem::create_directories(path, ec);
         if (ec)
             throw Error(Status::io_error,
                         path.string() + ": cannot create a temporary folder: " + ec.message());
     }
-    ~TempFolder()
-    {
-        std::error_code ec;
-        std::filesystem::remove_all(path, ec);
-    }
-    TempFolder(const TempFolder&) = delete;
-    TempFolder& operator=(const TempFolder&) = delete;
 };
 
 std::string last_line(const std::filesystem::path& log)
@@ -250,23 +258,66 @@ struct CommandResult {
     std::string note; ///< why there is no mesh
 };
 
-CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log)
+/// Runs the shell line in its own process group, so that a timeout or a signal kills the whole
+/// tool (a shell may have started several processes). Returns the wait status, or -1 if it could
+/// not start; `timed_out` is set if it was killed after `timeout_seconds` (<= 0: no limit).
+int run_shell(const std::string& line, double timeout_seconds, bool& timed_out)
+{
+    timed_out = false;
+    const char* const argv[] = {"/bin/sh", "-c", line.c_str(), nullptr};
+    const pid_t pid = io::detail::start_child([&argv] {
+        // In the forked child: async-signal-safe calls only, then exec.
+        ::setpgid(0, 0);
+        sigset_t none;
+        sigemptyset(&none);
+        ::pthread_sigmask(SIG_SETMASK, &none, nullptr); // the CLI blocks SIGINT/SIGTERM/SIGHUP
+        ::execv(argv[0], const_cast<char* const*>(argv));
+    });
+    if (pid < 0) return -1;
+    const auto deadline = std::chrono::steady_clock::now() +
+                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                              std::chrono::duration<double>(timeout_seconds));
+    auto pause = std::chrono::microseconds(100); // most tools take milliseconds: poll often, then less
+    int status = 0;
+    for (;;) {
+        const pid_t r = ::waitpid(pid, &status, WNOHANG);
+        if (r == pid) break;
+        if (r < 0 && errno != EINTR) {
+            status = -1;
+            break;
+        }
+        if (timeout_seconds > 0 && std::chrono::steady_clock::now() >= deadline) {
+            ::kill(-pid, SIGKILL);
+            while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+            }
+            timed_out = true;
+            break;
+        }
+        std::this_thread::sleep_for(pause);
+        pause = std::min<std::chrono::microseconds>(pause * 2, std::chrono::milliseconds(20));
+    }
+    io::detail::forget_child(pid);
+    return status;
+}
+
+CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log,
+                          double timeout_seconds)
 {
     std::error_code ec;
     std::filesystem::remove(command.output, ec);
     const std::string line =
         "(" + command.shell + ") >" + shell_quote(log.string()) + " 2>&1 </dev/null";
-    const int status = std::system(line.c_str());
+    bool timed_out = false;
+    const int status = run_shell(line, timeout_seconds, timed_out);
     CommandResult result;
     if (status == -1) {
-        result.note = "could not start the command (std::system returned -1)";
+        result.note = "could not start the command (fork or wait failed)";
         return result;
     }
-    if (WIFSIGNALED(status)) {
-        if (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGQUIT) {
-            throw Error(Status::io_error, "verify: interrupted (the command was killed by signal " +
-                                              std::to_string(WTERMSIG(status)) + ")");
-        }
+    if (timed_out) {
+        result.note = "the command did not finish within " + number_text(timeout_seconds) +
+                      " s (--timeout) and was killed";
+    } else if (WIFSIGNALED(status)) {
         result.note = "the command was killed by signal " + std::to_string(WTERMSIG(status));
     } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
         result.note = "the command exited with status " + std::to_string(WEXITSTATUS(status));
@@ -325,7 +376,8 @@ void check_entry(const EntryCheck& check, const DatasetVerifyOptions& options,
         if (tally.report.external) {
             const ExternalCommand command = expand_command(options.command, path, entry.iso,
                                                            scratch.string() + "-" + outcome.name);
-            CommandResult result = run_command(command, scratch.string() + "-log.txt");
+            CommandResult result =
+                run_command(command, scratch.string() + "-log.txt", options.timeout_seconds);
             outcome.mesh = std::move(result.mesh);
             outcome.note = std::move(result.note);
             outcome.subcases = subcases_of(*volume, entry.iso, Method::cmc33, nullptr);
@@ -367,10 +419,56 @@ std::string write_field(const std::filesystem::path& dir, FieldKind kind, std::i
            std::to_string(t.boundary_loops) + "\t" + subcase + "\n";
 }
 
+/// Why a dataset may not be written into `dir`, or "" if it may: `dir` does not exist, is an
+/// empty folder, or holds a previous dataset and nothing else (manifest.tsv, README.txt, and in
+/// cells/ grids/ closed/ only the files its manifest lists), which is then replaced.
+std::string unfit_reason(const std::filesystem::path& dir)
+{
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (!fs::exists(dir, ec)) return {};
+    if (!fs::is_directory(dir, ec)) return "exists and is not a folder";
+    if (fs::is_empty(dir, ec)) return {};
+    if (!fs::exists(dir / "manifest.tsv", ec)) {
+        return "folder is not empty and holds no dataset (no manifest.tsv)";
+    }
+    std::vector<std::string> listed;
+    try {
+        for (const ManifestEntry& e : read_manifest(dir)) listed.push_back(e.file);
+    } catch (const Error& e) {
+        return std::string("folder is not empty and its manifest.tsv is not a dataset's (") + e.what() + ")";
+    }
+    std::sort(listed.begin(), listed.end());
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec)) {
+        const std::string rel = it->path().lexically_relative(dir).generic_string();
+        const bool top = it.depth() == 0;
+        const bool folder = it->is_directory(ec) && !it->is_symlink(ec);
+        bool ours = false;
+        if (top && folder && rel.rfind(kTempPrefix, 0) == 0) {
+            it.disable_recursion_pending(); // left by a killed run: removed at the end
+            continue;
+        }
+        if (top) {
+            ours = folder ? rel == "cells" || rel == "grids" || rel == "closed" || rel == "ties"
+                          : (rel == "manifest.tsv" || rel == "README.txt") && it->is_regular_file(ec);
+        } else {
+            ours = !folder && it->is_regular_file(ec) && !it->is_symlink(ec) &&
+                   std::binary_search(listed.begin(), listed.end(), rel);
+        }
+        if (!ours) {
+            return "folder holds " + rel + ", which is not part of the dataset its manifest.tsv lists";
+        }
+    }
+    if (ec) return "folder cannot be listed: " + ec.message();
+    return {};
+}
+
 } // namespace
 
 DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options)
 {
+    namespace fs = std::filesystem;
     if (options.cells < 0 || options.grids < 0 || options.closed < 0 || options.ties < 0) {
         throw Error(Status::invalid_argument, "dataset: field counts must be >= 0; got cells " +
                                                   std::to_string(options.cells) + ", grids " +
@@ -384,24 +482,39 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
                                                   " is out of range; expected " +
                                                   std::to_string(min_size) + " to 1024");
     }
-    std::error_code ec;
-    if (std::filesystem::exists(dir, ec)) {
-        if (!std::filesystem::is_directory(dir, ec)) {
-            throw Error(Status::invalid_argument,
-                        dir.string() +
-                            ": exists and is not a folder; expected a new or empty folder");
-        }
-        if (std::filesystem::directory_iterator(dir, ec) != std::filesystem::directory_iterator()) {
-            throw Error(Status::invalid_argument,
-                        dir.string() + ": folder is not empty; expected a new or empty folder");
-        }
+    if (dir.empty()) {
+        throw Error(Status::invalid_argument,
+                    "dataset: the folder name is empty; expected a new, empty or dataset folder");
     }
+    const std::string unfit = unfit_reason(dir);
+    if (!unfit.empty()) {
+        throw Error(Status::invalid_argument,
+                    dir.string() + ": " + unfit + "; expected a new, empty or dataset folder");
+    }
+
+    // Everything is written into a hidden folder inside `dir` and moved into place at the end:
+    // a failure or a signal removes that folder (and `dir`, if it was made here), and a previous
+    // dataset is replaced only by a complete one.
+    std::error_code ec;
+    std::optional<io::detail::Temporary> made;
+    if (!fs::exists(dir, ec)) {
+        made.emplace(dir, [&] {
+            fs::create_directories(dir, ec);
+            if (ec) throw Error(Status::io_error, dir.string() + ": cannot create the folder: " + ec.message());
+        });
+    }
+    const fs::path temp_dir = dir / (std::string(kTempPrefix) + std::to_string(::getpid()));
+    io::detail::Temporary temp(temp_dir, [&] {
+        fs::remove_all(temp_dir, ec); // left by a killed run with the same pid
+        fs::create_directory(temp_dir, ec);
+        if (ec) throw Error(Status::io_error, temp_dir.string() + ": cannot create the folder: " + ec.message());
+    });
     const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids, options.closed,
                                                            options.ties};
     for (std::size_t k = 0; k < counts.size(); ++k) {
         if (counts[k] == 0) continue;
-        const auto folder = dir / kFolders[k];
-        std::filesystem::create_directories(folder, ec);
+        const auto folder = temp_dir / kFolders[k];
+        fs::create_directories(folder, ec);
         if (ec) {
             throw Error(Status::io_error,
                         folder.string() + ": cannot create the folder: " + ec.message());
@@ -421,7 +534,7 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
             counts[k], threads, 16, tick, [&](int, std::int64_t begin, std::int64_t end) {
                 for (std::int64_t i = begin; i < end; ++i) {
                     lines[static_cast<std::size_t>(i)] =
-                        write_field(dir, kind, i + 1, options.seed, options.size);
+                        write_field(temp_dir, kind, i + 1, options.seed, options.size);
                 }
             });
         for (const std::string& line : lines) {
@@ -434,8 +547,26 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
         }
         tick.pass_done(counts[k]);
     }
-    write_text(dir / "manifest.tsv", manifest);
-    write_text(dir / "README.txt", readme_text(options, summary));
+    write_text(temp_dir / "manifest.tsv", manifest);
+    write_text(temp_dir / "README.txt", readme_text(options, summary));
+    temp.commit([&] {
+        // The old manifest goes first and the new one comes last: a folder caught in between
+        // is never taken for a complete dataset.
+        for (const char* name : {"manifest.tsv", "README.txt", "cells", "grids", "closed", "ties"}) {
+            fs::remove_all(dir / name, ec);
+            if (ec) throw Error(Status::io_error, (dir / name).string() + ": cannot remove: " + ec.message());
+        }
+        for (const char* name : {"cells", "grids", "closed", "ties", "README.txt", "manifest.tsv"}) {
+            if (!fs::exists(temp_dir / name)) continue;
+            fs::rename(temp_dir / name, dir / name, ec);
+            if (ec) throw Error(Status::io_error, (dir / name).string() + ": cannot move it into place: " + ec.message());
+        }
+        fs::remove(temp_dir, ec);
+        for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+            if (e.path().filename().string().rfind(kTempPrefix, 0) == 0) fs::remove_all(e.path(), ec);
+        }
+    });
+    if (made) made->commit([] {});
     summary.seconds = tick.seconds();
     tick(0);
     return summary;

@@ -177,7 +177,14 @@ void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir,
             const std::string& command_template, VerifyReport& report)
 {
     bool any = false;
-    for (const Tally& t : tallies) any = any || !t.failures.empty();
+    for (Tally& t : tallies) {
+        any = any || !t.failures.empty();
+        for (const Failure& f : t.failures) { // in run order (merge trims and sorts them)
+            if (f.mesh) continue;
+            t.report.first_error = f.name + ": " + f.note;
+            break;
+        }
+    }
     if (any && !dir.empty()) {
         std::error_code ec;
         std::filesystem::create_directories(dir, ec);

@@ -199,8 +199,9 @@ TEST(Extract, TiesAreEmbeddedAndStayOffTheSamples)
             EXPECT_EQ(g.welded.nonmanifold_edges, 0);
             for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
                 // grid coordinates; the distance to the nearest sample along each axis
-                const double x[3] = {(mesh.positions[3 * q] + 3.0) / 0.5, mesh.positions[3 * q + 1] / 1.0,
-                                     (mesh.positions[3 * q + 2] - 10.0) / 2.0};
+                const double x[3] = {(static_cast<double>(mesh.positions[3 * q]) + 3.0) / 0.5,
+                                     static_cast<double>(mesh.positions[3 * q + 1]) / 1.0,
+                                     (static_cast<double>(mesh.positions[3 * q + 2]) - 10.0) / 2.0};
                 double off = 0;
                 for (double c : x) off = std::max(off, std::fabs(c - std::round(c)));
                 ASSERT_GE(off, 0x1p-10 * 0.999) << "vertex " << q << " sits on a sample";
@@ -222,7 +223,7 @@ TEST(Extract, ABumpExactlyAtTheIsovalueIsATinyClosedSurface)
     EXPECT_EQ(mesh.vertex_count(), 6u);
     for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
         double d = 0;
-        for (int c = 0; c < 3; ++c) d += std::fabs(mesh.positions[3 * q + static_cast<std::size_t>(c)] - 1.0);
+        for (int c = 0; c < 3; ++c) d += std::fabs(static_cast<double>(mesh.positions[3 * q + static_cast<std::size_t>(c)]) - 1.0);
         EXPECT_DOUBLE_EQ(d, 0x1p-10);
     }
     EXPECT_TRUE(cmc33::mesh_geometry(mesh).embedded());

@@ -303,7 +303,7 @@ TEST(MeshTopology, EmptyMesh)
     EXPECT_EQ(t.closed_components, 0);
     EXPECT_EQ(t.b1, 0);
     EXPECT_FALSE(t.closed);
-    EXPECT_FALSE(t.oriented);
+    EXPECT_TRUE(t.oriented); // no edge is run the wrong way: trivially oriented
 
     const MeshTopology only_points = mesh_topology(make_mesh(4, {}));
     EXPECT_EQ(only_points.vertices, 0);
@@ -316,7 +316,7 @@ TEST(MeshTopology, OnlyDegenerateTriangles)
     EXPECT_EQ(t.degenerate_triangles, 2);
     expect_counts(t, 0, 0, 0);
     EXPECT_FALSE(t.closed);
-    EXPECT_FALSE(t.oriented);
+    EXPECT_TRUE(t.oriented); // like an empty mesh
 }
 
 TEST(MeshTopology, RejectsOutOfRangeIndex)

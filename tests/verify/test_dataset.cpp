@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -85,8 +86,56 @@ TEST(Dataset, WritesFilesManifestAndReadme)
             EXPECT_EQ(e.expected.boundary_loops, 0);
         }
     }
-    // The folder must be new or empty.
-    EXPECT_THROW((void)write_dataset(dir, DatasetOptions{}), Error);
+    // The folder must be new, empty or a previous dataset: one foreign file and it is refused,
+    // naming the file, and nothing is written or removed.
+    test::write_file(dir / "README-mine.txt", "my notes");
+    const std::size_t files_before = static_cast<std::size_t>(
+        std::distance(fs::recursive_directory_iterator(dir), fs::recursive_directory_iterator()));
+    try {
+        (void)write_dataset(dir, DatasetOptions{});
+        ADD_FAILURE() << "no exception";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("README-mine.txt"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(static_cast<std::size_t>(std::distance(fs::recursive_directory_iterator(dir),
+                                                     fs::recursive_directory_iterator())),
+              files_before);
+    EXPECT_EQ(test::read_file(dir / "README-mine.txt"), "my notes");
+    // Not a folder, and an empty name (it would mean the current folder).
+    EXPECT_THROW((void)write_dataset(dir / "README-mine.txt", DatasetOptions{}), Error);
+    EXPECT_THROW((void)write_dataset("", DatasetOptions{}), Error);
+}
+
+TEST(Dataset, ReplacesAPreviousDatasetAndNothingElse)
+{
+    const fs::path dir = small_dataset(test::temp_dir() / "dataset");
+    // Written again with other counts: the old files are gone, the new ones all there.
+    small_dataset(dir, 5, 3, 0);
+    const std::vector<ManifestEntry> entries = read_manifest(dir);
+    std::size_t files = 0;
+    for (const auto& e : fs::recursive_directory_iterator(dir)) files += e.is_regular_file() ? 1 : 0;
+    EXPECT_EQ(files, entries.size() + 2); // + manifest.tsv and README.txt
+    EXPECT_FALSE(fs::exists(dir / "closed"));
+    EXPECT_FALSE(fs::exists(dir / "cells" / "cell-000050.nrrd"));
+    // A file the manifest does not list makes it not a dataset any more.
+    test::write_file(dir / "cells" / "extra.nrrd", "x");
+    EXPECT_THROW(small_dataset(dir, 5, 3, 0), Error);
+    EXPECT_TRUE(fs::exists(dir / "cells" / "extra.nrrd"));
+    // A leftover of a killed run (its hidden temporary folder) is removed, not refused.
+    fs::remove(dir / "cells" / "extra.nrrd");
+    fs::create_directory(dir / ".cmc33-dataset-tmp99999999");
+    test::write_file(dir / ".cmc33-dataset-tmp99999999" / "x.nrrd", "x");
+    small_dataset(dir, 5, 3, 0);
+    EXPECT_FALSE(fs::exists(dir / ".cmc33-dataset-tmp99999999"));
+}
+
+TEST(Dataset, AFailureLeavesNothingBehind)
+{
+    // The folder's parent is a file: creating it fails at once.
+    const fs::path base = test::temp_dir();
+    test::write_file(base / "file", "x");
+    EXPECT_THROW(small_dataset(base / "file" / "dataset"), Error);
+    // A write that fails midway: tests/cli (CliDataset.LateFailureLeavesNothing, with ulimit -f).
 }
 
 TEST(Dataset, VerifiedInProcessLikeTheRandomRun)
