@@ -4,8 +4,10 @@
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 set -euo pipefail
 
+# libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
+# CGAL's self-intersection test (without it that test reports itself skipped).
 packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgmp-dev libgtest-dev libgmock-dev
-          libcli11-dev nlohmann-json3-dev libtbb-dev python3)
+          libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev)
 if [[ "${1:-}" == "--bench" ]]; then
     packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time)
 fi
