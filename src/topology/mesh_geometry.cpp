@@ -3,8 +3,9 @@
 //
 //   1. weld: vertices sorted by position; equal floats (with -0 == +0) share one welded id;
 //   2. triangles whose welded corners repeat or are collinear (exactly) are zero-area;
-//   3. the others go into the buckets of a uniform grid whose spacing is twice the mean triangle
-//      extent (a bucket key per grid cell a triangle's box overlaps), sorted by key;
+//   3. the others go into the buckets of a uniform grid whose spacing is twice the 90th percentile
+//      of the triangle extents (a bucket key per grid cell a triangle's box overlaps), sorted by
+//      key; triangles that would span more than 512 cells go to a coarser grid, level by level;
 //   4. in each bucket, every pair whose closed boxes overlap is tested once (in the bucket that
 //      holds the low corner of the boxes' intersection) with the exact tests of exact_geometry.hpp,
 //      according to how many welded corners the two triangles share.
@@ -46,6 +47,7 @@ struct Entry {
 
 constexpr int kKeyBits = 21;
 constexpr std::int64_t kCellsPerAxis = std::int64_t{1} << kKeyBits;
+constexpr std::int64_t kMaxCells = 512; ///< a triangle spanning more cells goes to a coarser level
 
 template <class Body> void parallel_for(std::int64_t n, int threads, Body&& body)
 {
@@ -83,8 +85,7 @@ public:
         validate();
         weld();
         classify_triangles();
-        bucket();
-        test_pairs();
+        test_all_levels();
         result_.welded = mesh_topology(welded_mesh());
         return result_;
     }
@@ -206,40 +207,80 @@ private:
                static_cast<std::uint64_t>(c[2]) << (2 * kKeyBits);
     }
 
-    void bucket()
+    /// Boxes of the proper triangles, and the box around all of them. False if there is none.
+    bool compute_boxes()
     {
         const std::size_t count = mesh_.triangle_count();
         boxes_.resize(count);
-        double extent = 0;
-        std::int64_t proper = 0;
-        Point3 lo{}, hi{};
+        level_.assign(count, -1);
+        bool any = false;
         for (std::size_t t = 0; t < count; ++t) {
             if (!proper_[t]) continue;
             const Box b = box_of(t);
             boxes_[t] = b;
-            extent += std::max({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]});
-            if (proper++ == 0) {
-                lo = b.lo;
-                hi = b.hi;
+            if (!any) {
+                origin_ = b.lo;
+                top_ = b.hi;
+                any = true;
             }
             for (std::size_t k = 0; k < 3; ++k) {
-                lo[k] = std::min(lo[k], b.lo[k]);
-                hi[k] = std::max(hi[k], b.hi[k]);
+                origin_[k] = std::min(origin_[k], b.lo[k]);
+                top_[k] = std::max(top_[k], b.hi[k]);
             }
         }
-        if (proper == 0) return;
-        origin_ = lo;
-        cell_ = 2 * extent / static_cast<double>(proper);
-        for (std::size_t k = 0; k < 3; ++k) cell_ = std::max(cell_, (hi[k] - lo[k]) / static_cast<double>(kCellsPerAxis - 2));
-        if (!(cell_ > 0)) cell_ = 1;
+        return any;
+    }
+
+    static double extent_of(const Box& b) { return std::max({b.hi[0] - b.lo[0], b.hi[1] - b.lo[1], b.hi[2] - b.lo[2]}); }
+
+    /// Grid levels for triangles of very different sizes: level L's cell is twice the 90th
+    /// percentile of the extents of the triangles not yet placed; a triangle whose box spans at
+    /// most kMaxCells cells takes level L. Level L's buckets hold every triangle of levels <= L, and
+    /// its pairs are those with at least one triangle of level L, so each pair is tested at one
+    /// level, and a large triangle among small ones costs the small ones it overlaps, not a
+    /// bucket per cell of its box.
+    void test_all_levels()
+    {
+        if (!compute_boxes()) return;
+        std::vector<std::uint32_t> unplaced;
+        for (std::size_t t = 0; t < proper_.size(); ++t)
+            if (proper_[t]) unplaced.push_back(static_cast<std::uint32_t>(t));
+        std::vector<std::uint32_t> placed;
+        for (int level = 0; !unplaced.empty(); ++level) {
+            std::vector<double> extents(unplaced.size());
+            for (std::size_t i = 0; i < unplaced.size(); ++i) extents[i] = extent_of(boxes_[unplaced[i]]);
+            const std::size_t p90 = extents.size() * 9 / 10;
+            std::nth_element(extents.begin(), extents.begin() + static_cast<std::ptrdiff_t>(p90), extents.end());
+            cell_ = 2 * extents[p90];
+            for (std::size_t k = 0; k < 3; ++k)
+                cell_ = std::max(cell_, (top_[k] - origin_[k]) / static_cast<double>(kCellsPerAxis - 2));
+            if (!(cell_ > 0)) cell_ = 1;
+            std::vector<std::uint32_t> rest;
+            for (std::uint32_t t : unplaced) {
+                const auto c0 = cell_of(boxes_[t].lo), c1 = cell_of(boxes_[t].hi);
+                const std::int64_t cells = (c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) * (c1[2] - c0[2] + 1);
+                if (cells <= kMaxCells) {
+                    level_[t] = level;
+                    placed.push_back(t);
+                } else {
+                    rest.push_back(t);
+                }
+            }
+            unplaced = std::move(rest);
+            bucket(placed);
+            test_pairs(level);
+        }
+        merge_examples();
+    }
+
+    void bucket(const std::vector<std::uint32_t>& triangles)
+    {
         entries_.clear();
-        for (std::size_t t = 0; t < count; ++t) {
-            if (!proper_[t]) continue;
+        for (std::uint32_t t : triangles) {
             const auto c0 = cell_of(boxes_[t].lo), c1 = cell_of(boxes_[t].hi);
             for (std::int64_t z = c0[2]; z <= c1[2]; ++z)
                 for (std::int64_t y = c0[1]; y <= c1[1]; ++y)
-                    for (std::int64_t x = c0[0]; x <= c1[0]; ++x)
-                        entries_.push_back({key_of({x, y, z}), static_cast<std::uint32_t>(t)});
+                    for (std::int64_t x = c0[0]; x <= c1[0]; ++x) entries_.push_back({key_of({x, y, z}), t});
         }
         std::sort(entries_.begin(), entries_.end());
         groups_.clear();
@@ -272,28 +313,36 @@ private:
         return detail::triangles_meet_improperly(pa, pb, shared);
     }
 
-    void test_pairs()
+    /// Tests the pairs of level `level` (at least one of its triangles of that level) in every
+    /// bucket, each pair once: in the bucket of the low corner of the two boxes' overlap.
+    void test_pairs(int level)
     {
-        const auto group_count = static_cast<std::int64_t>(groups_.empty() ? 0 : groups_.size() - 1);
-        std::vector<std::int64_t> found(static_cast<std::size_t>(threads_), 0);
-        std::vector<std::vector<std::array<std::int64_t, 2>>> examples(static_cast<std::size_t>(threads_));
+        const auto group_count = static_cast<std::int64_t>(groups_.size() - 1);
+        found_.resize(static_cast<std::size_t>(threads_), 0);
+        examples_.resize(static_cast<std::size_t>(threads_));
         parallel_for(group_count, threads_, [&](int th, std::int64_t g0, std::int64_t g1) {
-            auto& mine = examples[static_cast<std::size_t>(th)];
+            auto& mine = examples_[static_cast<std::size_t>(th)];
+            std::vector<std::uint32_t> top, all;
             for (std::int64_t g = g0; g < g1; ++g) {
                 const std::size_t begin = groups_[static_cast<std::size_t>(g)];
                 std::size_t end = begin + 1;
                 while (end < entries_.size() && entries_[end].key == entries_[begin].key) ++end;
-                for (std::size_t i = begin; i < end; ++i)
-                    for (std::size_t j = i + 1; j < end; ++j) {
-                        const std::uint32_t ta = entries_[i].triangle, tb = entries_[j].triangle;
+                top.clear();
+                all.clear();
+                for (std::size_t i = begin; i < end; ++i) {
+                    all.push_back(entries_[i].triangle);
+                    if (level_[entries_[i].triangle] == level) top.push_back(entries_[i].triangle);
+                }
+                for (std::uint32_t ta : top)
+                    for (std::uint32_t tb : all) {
+                        if (tb == ta || (level_[tb] == level && tb < ta)) continue; // each pair once
                         const Box &ba = boxes_[ta], &bb = boxes_[tb];
                         if (!boxes_overlap(ba, bb)) continue;
-                        // test the pair once: in the bucket of the low corner of the boxes' overlap
                         const Point3 low{std::max(ba.lo[0], bb.lo[0]), std::max(ba.lo[1], bb.lo[1]),
                                          std::max(ba.lo[2], bb.lo[2])};
                         if (key_of(cell_of(low)) != entries_[begin].key) continue;
                         if (!pair_meets(ta, tb)) continue;
-                        ++found[static_cast<std::size_t>(th)];
+                        ++found_[static_cast<std::size_t>(th)];
                         mine.push_back({std::min<std::int64_t>(ta, tb), std::max<std::int64_t>(ta, tb)});
                         if (mine.size() > 4 * options_.examples + 64) {
                             std::sort(mine.begin(), mine.end());
@@ -302,10 +351,14 @@ private:
                     }
             }
         });
+    }
+
+    void merge_examples()
+    {
         std::vector<std::array<std::int64_t, 2>> all;
-        for (std::size_t t = 0; t < found.size(); ++t) {
-            result_.intersecting_pairs += found[t];
-            all.insert(all.end(), examples[t].begin(), examples[t].end());
+        for (std::size_t t = 0; t < found_.size(); ++t) {
+            result_.intersecting_pairs += found_[t];
+            all.insert(all.end(), examples_[t].begin(), examples_[t].end());
         }
         std::sort(all.begin(), all.end());
         if (all.size() > options_.examples) all.resize(options_.examples);
@@ -331,10 +384,13 @@ private:
     std::vector<Point3> points_;
     std::vector<std::uint8_t> proper_;
     std::vector<Box> boxes_;
-    Point3 origin_{};
+    std::vector<int> level_; ///< grid level of each proper triangle (test_all_levels)
+    Point3 origin_{}, top_{};
     double cell_ = 1;
     std::vector<Entry> entries_;
     std::vector<std::size_t> groups_; ///< start of every bucket with two or more entries, then the end
+    std::vector<std::int64_t> found_; ///< intersecting pairs found, per thread
+    std::vector<std::vector<std::array<std::int64_t, 2>>> examples_; ///< the smallest of them, per thread
 };
 
 } // namespace
