@@ -70,7 +70,7 @@ void run_extract(const ExtractArgs& args)
     MeshTopology topology;
     MeshGeometry geometry;
     if (!args.no_topology) topology = mesh_topology(mesh);
-    if (!args.no_topology && args.json) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
+    if (!args.no_topology) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
     if (!args.output.empty()) io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii});
 
     const int threads = args.threads > 0 ? args.threads
@@ -92,7 +92,7 @@ void run_extract(const ExtractArgs& args)
                  {"threads", threads},
                  {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
                  {"topology", !args.no_topology ? topology_json(topology) : Json(nullptr)},
-                 {"geometry", !args.no_topology && args.json ? geometry_json(geometry) : Json(nullptr)},
+                 {"geometry", !args.no_topology ? geometry_json(geometry) : Json(nullptr)},
                  {"subcases", subcases}};
         print_json(out);
         return;
@@ -110,6 +110,13 @@ void run_extract(const ExtractArgs& args)
     }
     if (!args.no_topology && topology.nonmanifold_vertices != 0) {
         line += ", non-manifold vertices " + std::to_string(topology.nonmanifold_vertices);
+    }
+    if (!args.no_topology) {
+        line += geometry.embedded() ? ", embedded"
+                                    : ", NOT embedded (" + std::to_string(geometry.coincident_vertices) +
+                                          " coincident vertices, " + std::to_string(geometry.zero_area_triangles) +
+                                          " zero-area triangles, " + std::to_string(geometry.intersecting_pairs) +
+                                          " intersecting triangle pairs)";
     }
     if (!args.output.empty()) line += " (" + args.output + ")";
     std::cout << line << '\n';
