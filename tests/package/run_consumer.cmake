@@ -1,0 +1,24 @@
+# Builds and runs tests/package/consumer against cmc33 (cmake -P):
+#   -DMODE=package      -DCMC33_BUILD=<cmc33 build tree> -DWORK=<scratch folder>: installs the build
+#                       tree into WORK/prefix, then builds the consumer with find_package(cmc33)
+#   -DMODE=subdirectory -DCMC33_SOURCE=<cmc33 source tree> -DWORK=<scratch folder>
+# Also needs -DSOURCE=<this folder> and -DGENERATOR=<CMake generator>.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+function(run)
+    execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+        string(REPLACE ";" " " line "${ARGN}")
+        message(FATAL_ERROR "failed (${rc}): ${line}")
+    endif()
+endfunction()
+if(MODE STREQUAL "package")
+    run(${CMAKE_COMMAND} --install ${CMC33_BUILD} --prefix ${WORK}/prefix)
+    run(${CMAKE_COMMAND} -S ${SOURCE}/consumer -B ${WORK}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+        -DCMC33_CONSUME=package -DCMAKE_PREFIX_PATH=${WORK}/prefix)
+else()
+    run(${CMAKE_COMMAND} -S ${SOURCE}/consumer -B ${WORK}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+        -DCMC33_CONSUME=subdirectory -DCMC33_SOURCE_DIR=${CMC33_SOURCE})
+endif()
+run(${CMAKE_COMMAND} --build ${WORK}/build -j2)
+run(${WORK}/build/consumer)
