@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
 
 namespace cmc33::io::detail {
@@ -30,9 +31,6 @@ void write_obj(const Mesh& mesh, std::ostream& out);
 void write_stl(const Mesh& mesh, std::ostream& out);
 void write_off(const Mesh& mesh, std::ostream& out);
 
-/// Reads a mesh image by the extension of `name` (".ply", ".obj", ".stl", ".off").
-/// @throws Error{unsupported_format} for another extension, Error for bad content.
-Mesh read_mesh_bytes(std::string_view bytes, const std::string& name);
 
 // ---- messages -------------------------------------------------------------------------------
 

@@ -16,6 +16,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
+#include "io/atomic_file.hpp"
 #include "io/mesh_formats.hpp"
 #include "test_support.hpp"
 
@@ -33,7 +34,13 @@ using Floats = cmc33::Buffer<float>;
 Mesh read_bytes(const std::string& bytes, const std::string& name)
 {
     const std::vector<char> exact(bytes.begin(), bytes.end());
-    return detail::read_mesh_bytes(std::string_view(exact.data(), exact.size()), name);
+    const std::string ext = detail::lower_extension(name);
+    const cmc33::io::MeshFormat format = ext == ".ply"   ? cmc33::io::MeshFormat::ply
+                                         : ext == ".obj" ? cmc33::io::MeshFormat::obj
+                                         : ext == ".stl" ? cmc33::io::MeshFormat::stl
+                                                         : cmc33::io::MeshFormat::off;
+    return cmc33::io::read_mesh_from_memory(std::string_view(exact.data(), exact.size()), format,
+                                            name);
 }
 
 void expect_error(const std::string& bytes, const std::string& name, Status status,
