@@ -371,10 +371,10 @@ std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t sk
         got += made;
         if (made < n) fail_short();
     }
-    // Real volumes compress a few times; start at 16 times the stream (at least 16 MiB, never
+    // Real volumes compress a few times; start at 16 times the stream (at least 1 MiB, never
     // more than declared) and double while the stream keeps producing.
     constexpr std::size_t kRatioGuess = 16;
-    constexpr std::size_t kMinimum = std::size_t{16} << 20;
+    constexpr std::size_t kMinimum = std::size_t{1} << 20;
     const std::size_t guess = in.size() > std::numeric_limits<std::size_t>::max() / kRatioGuess
                                   ? out_size
                                   : std::max(kMinimum, kRatioGuess * in.size());
