@@ -55,6 +55,13 @@ bool parse_int(std::string_view token, std::int64_t& value);
 
 // ---- text -----------------------------------------------------------------------------------
 
+/// Text meshes are lines of records, and every writer ends its lines: a file whose last line has
+/// no line end and ends in what may be part of a number (a digit, '.', '/', 'e', '+', '-'; the
+/// token starts like a number) may have been cut inside that number, so it is refused
+/// (docs/formats.md). Text after a `comment` character on that line is not looked at.
+/// @throws Error{truncated_file}.
+void check_text_end(std::string_view bytes, char comment, const std::string& name);
+
 /// Whitespace-separated tokens over a text, with line numbers. '\n' ends a line ("\r\n" too);
 /// when `comment` is not 0, a token starting with it hides the rest of its line.
 class TextCursor {

@@ -156,6 +156,30 @@ std::string_view TextCursor::rest_of_line() const
     return rest;
 }
 
+void check_text_end(std::string_view bytes, char comment, const std::string& name)
+{
+    if (bytes.empty() || bytes.back() == '\n' || is_blank(bytes.back())) return;
+    const std::size_t newline = bytes.rfind('\n');
+    const std::size_t start = newline == std::string_view::npos ? 0 : newline + 1;
+    const std::string_view line = bytes.substr(start);
+    if (comment != 0 && line.find(comment) != std::string_view::npos) return;
+    std::size_t begin = line.size();
+    while (begin > 0 && !is_blank(line[begin - 1])) --begin;
+    const std::string_view token = line.substr(begin);
+    auto starts_number = [](char c) { return (c >= '0' && c <= '9') || c == '+' || c == '-' || c == '.'; };
+    auto continues_number = [](char c) {
+        return (c >= '0' && c <= '9') || c == '.' || c == '/' || c == 'e' || c == 'E' || c == '+' ||
+               c == '-';
+    };
+    if (token.empty() || !starts_number(token.front()) || !continues_number(token.back())) return;
+    std::size_t line_number = 1;
+    for (char c : bytes.substr(0, start)) line_number += c == '\n' ? 1 : 0;
+    throw Error(Status::truncated_file,
+                concat(name, ": line ", line_number, ": the file ends inside the number ",
+                       quote_text(token),
+                       " (no line end after it): cut short? A complete file ends its last line"));
+}
+
 // ---- output ---------------------------------------------------------------------------------
 
 void OutputBuffer::real(float value)
