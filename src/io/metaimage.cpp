@@ -109,7 +109,8 @@ void check_identity(const Field& field, const std::string& label)
         double v = 0;
         if (!parse_real(words[i], v)) {
             throw Error(Status::bad_format, str_cat(label, ": ", field_name(field), " value ",
-                                                    quote_bytes(words[i]), " is not a number"));
+                                                    quote_bytes(words[i]), ' ',
+                                                    real_problem(words[i])));
         }
         const double expected = i % 4 == 0 ? 1.0 : 0.0;
         if (!(std::fabs(v - expected) <= 1e-6)) {

@@ -180,7 +180,8 @@ parse_vectors(const Field& field, std::string_view name, const std::string& labe
             if (!parse_real(token, value)) {
                 throw Error(Status::bad_format,
                             str_cat(label, ": field \"", name, "\" (line ", field.line,
-                                    "): component ", quote_bytes(token), " is not a number"));
+                                    "): component ", quote_bytes(token), ' ',
+                                    real_problem(token)));
             }
             if (!std::isfinite(value)) {
                 throw Error(Status::non_finite,
@@ -223,6 +224,22 @@ Vec3 parse_space_directions(const Field& field, const std::string& label)
         // Axis-aligned: the other two components vanish (up to rounding in the writer).
         const bool aligned = norm > 0 && std::fabs(v[(axis + 1) % 3]) <= 1e-9 * norm &&
                              std::fabs(v[(axis + 2) % 3]) <= 1e-9 * norm;
+        // One non-zero component elsewhere than on the diagonal: the axes are permuted, which
+        // is axis-aligned but not the sample order cmc33 reads.
+        std::size_t along = 3;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const bool others_vanish = std::fabs(v[(c + 1) % 3]) <= 1e-9 * norm &&
+                                       std::fabs(v[(c + 2) % 3]) <= 1e-9 * norm;
+            if (norm > 0 && others_vanish) along = c;
+        }
+        if (!aligned && along != 3) {
+            throw Error(Status::unsupported_format,
+                        str_cat(label, ": space directions ", quote_bytes(field.value, 80),
+                                " (line ", field.line, ") permute the axes (sample axis ",
+                                axis + 1, " runs along space axis ", along + 1,
+                                "); cmc33 reads only diagonal directions like (sx,0,0) "
+                                "(0,sy,0) (0,0,sz)"));
+        }
         if (!aligned) {
             throw Error(Status::unsupported_format,
                         str_cat(label, ": space directions ", quote_bytes(field.value, 80),

@@ -63,6 +63,8 @@ std::string dims_text(const Index3& dims);
 
 /// The whole token is a decimal number (a leading '+' is accepted; "nan", "inf" too).
 bool parse_real(std::string_view token, double& value);
+/// Why parse_real refused `token`: "is out of the double range ..." or "is not a number".
+std::string real_problem(std::string_view token);
 /// The whole token is a decimal integer (a leading '+' is accepted).
 bool parse_integer(std::string_view token, std::int64_t& value);
 

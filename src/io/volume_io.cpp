@@ -113,6 +113,15 @@ std::string dims_text(const Index3& dims)
 
 namespace {
 
+template <class T> std::string range_text()
+{
+    if constexpr (std::is_floating_point_v<T>) {
+        return str_cat("+-", std::numeric_limits<T>::max());
+    } else {
+        return str_cat(+std::numeric_limits<T>::lowest(), "..", +std::numeric_limits<T>::max());
+    }
+}
+
 std::string_view without_leading_plus(std::string_view token) noexcept
 {
     if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+')
@@ -174,6 +183,14 @@ bool parse_real(std::string_view token, double& value)
     return parse_floating(token, value) == Parsed::ok;
 }
 
+std::string real_problem(std::string_view token)
+{
+    double value = 0;
+    if (parse_floating(token, value) == Parsed::out_of_range)
+        return "is out of the double range " + range_text<double>();
+    return "is not a number";
+}
+
 bool parse_integer(std::string_view token, std::int64_t& value)
 {
     return parse_int64(token, value) == Parsed::ok;
@@ -218,7 +235,8 @@ Vec3 parse_vec3(const std::vector<std::string_view>& words, const std::string& l
     for (std::size_t axis = 0; axis < 3; ++axis) {
         if (!parse_real(words[axis], v[axis])) {
             throw Error(Status::bad_format, str_cat(label, ": ", what, " value ",
-                                                    quote_bytes(words[axis]), " is not a number"));
+                                                    quote_bytes(words[axis]), ' ',
+                                                    real_problem(words[axis])));
         }
         if (!std::isfinite(v[axis])) {
             throw Error(Status::non_finite, str_cat(label, ": ", what, " value ",
@@ -305,15 +323,6 @@ std::string declared(const Grid& grid, std::uint64_t bytes)
 {
     return str_cat("header declares ", dims_text(grid.dims), ' ', type_name(grid.type), " (", bytes,
                    " bytes)");
-}
-
-template <class T> std::string range_text()
-{
-    if constexpr (std::is_floating_point_v<T>) {
-        return str_cat("+-", std::numeric_limits<T>::max());
-    } else {
-        return str_cat(+std::numeric_limits<T>::lowest(), "..", +std::numeric_limits<T>::max());
-    }
 }
 
 template <class T>

@@ -432,7 +432,7 @@ TEST(VolumeErrors, NrrdUnsupportedVariants)
                       Status::unsupported_format, {"not axis-aligned", "(0.7,0.7,0)"});
     expect_file_error(dir, "perm.nrrd",
                       kNrrd16 + "space directions: (0,1,0) (1,0,0) (0,0,1)\n" + data,
-                      Status::unsupported_format, {"not axis-aligned"});
+                      Status::unsupported_format, {"permute the axes"});
     expect_file_error(dir, "none.nrrd", kNrrd16 + "space directions: none (1,0,0) (0,1,0)\n" + data,
                       Status::unsupported_format, {"\"none\""});
     expect_file_error(dir, "2d.nrrd", kNrrd16 + "space directions: (1,0) (0,1) (1,1)\n" + data,
