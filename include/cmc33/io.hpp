@@ -8,6 +8,8 @@
 ///
 /// Every reader checks every size it is told against what the file holds before allocating, and
 /// throws `Error` with a one-line message that names the file, what is wrong and what was expected.
+/// Fewer or more data than a header declares is an error; docs/formats.md gives the whole policy
+/// (trailing bytes, final newlines, text cut inside a number). Each reader is fuzzed (fuzz/).
 /// Writers write a temporary file next to the target and rename it, so a failed write never leaves
 /// a half-written file behind.
 
