@@ -1,16 +1,21 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench]
+# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz]
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
+#   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
 # CGAL's self-intersection test (without it that test reports itself skipped).
 packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev)
-if [[ "${1:-}" == "--bench" ]]; then
-    packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time)
-fi
+for flag in "$@"; do
+    case "$flag" in
+    --bench) packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time) ;;
+    --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
+    esac
+done
 
 missing=()
 for p in "${packages[@]}"; do

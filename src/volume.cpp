@@ -27,10 +27,11 @@ std::size_t type_size(ScalarType type) noexcept
     return dispatch_scalar_type(type, [](auto tag) { return sizeof(tag); });
 }
 
-Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin)
-    : type_(type), dims_(dims), spacing_(spacing), origin_(origin)
+namespace {
+
+/// Bytes of the samples; sizes come from files, so every product is checked.
+std::size_t checked_byte_size(ScalarType type, const Index3& dims)
 {
-    // Sizes come from files: check every product before allocating.
     std::uint64_t bytes = type_size(type);
     for (std::int64_t d : dims) {
         if (d < 1) {
@@ -45,13 +46,30 @@ Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin)
     if (bytes > static_cast<std::uint64_t>(std::numeric_limits<std::ptrdiff_t>::max())) {
         throw Error(Status::too_large, "volume of " + std::to_string(bytes) + " bytes is larger than memory can address");
     }
+    return static_cast<std::size_t>(bytes);
+}
+
+} // namespace
+
+Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin)
+    : type_(type), dims_(dims), spacing_(spacing), origin_(origin)
+{
+    const std::size_t bytes = checked_byte_size(type, dims);
     try {
-        data_.reset(new std::byte[static_cast<std::size_t>(bytes)]());
+        data_.reset(new std::byte[bytes]());
     } catch (const std::bad_alloc&) {
         throw Error(Status::too_large, "cannot allocate " + std::to_string(bytes) + " bytes for a " +
                                            std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                                            std::to_string(dims[2]) + " " + std::string(type_name(type)) + " volume");
     }
+}
+
+Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin, std::unique_ptr<std::byte[]> samples)
+    : type_(type), dims_(dims), spacing_(spacing), origin_(origin)
+{
+    checked_byte_size(type, dims);
+    if (!samples) throw Error(Status::invalid_argument, "volume samples are missing (null buffer)");
+    data_ = std::move(samples);
 }
 
 void Volume::check_type(ScalarType wanted) const

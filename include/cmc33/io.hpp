@@ -8,12 +8,16 @@
 ///
 /// Every reader checks every size it is told against what the file holds before allocating, and
 /// throws `Error` with a one-line message that names the file, what is wrong and what was expected.
+/// Fewer or more data than a header declares is an error; docs/formats.md gives the whole policy
+/// (trailing bytes, final newlines, text cut inside a number). Each reader is fuzzed (fuzz/).
 /// Writers write a temporary file next to the target and rename it, so a failed write never leaves
 /// a half-written file behind.
 
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
@@ -56,6 +60,42 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshW
 /// with more than three vertices are fanned. STL has no indices: exactly coincident vertices are
 /// welded. @throws Error.
 Mesh read_mesh(const std::filesystem::path& path);
+
+/// A volume format, for bytes that have no file name to tell it.
+enum class VolumeFormat {
+    nrrd,      ///< attached header (the samples follow it) or detached ("data file: NAME")
+    metaimage, ///< .mha (ElementDataFile = LOCAL) or .mhd (ElementDataFile = NAME)
+    vtk,       ///< VTK legacy STRUCTURED_POINTS
+    raw,       ///< headerless samples described by RawOptions
+};
+
+/// The data files of a detached header, held in memory: called with the name as the header writes
+/// it ("data file:" in NRRD, ElementDataFile in MetaImage), returns that file's bytes, or nullopt
+/// if there is no such file. The bytes must stay valid until the read returns.
+using MemoryFiles = std::function<std::optional<std::string_view>(std::string_view name)>;
+
+/// Reads a volume from bytes in memory, exactly as read_volume() reads a file of that format
+/// (the same parser and the same checks; read_volume() calls the same code). `label` stands for
+/// the file's name at the start of every message. `raw` is required for VolumeFormat::raw and
+/// ignored otherwise; `data_files` serves the data files of detached headers (none if empty).
+/// @throws Error, as read_volume(); never another exception type, whatever the bytes.
+///
+///     const io::MemoryFiles files = [&](std::string_view name) {
+///         return name == "ct.raw" ? std::optional<std::string_view>(raw_bytes) : std::nullopt;
+///     };
+///     Volume v = io::read_volume_from_memory(nhdr_text, io::VolumeFormat::nrrd, "ct.nhdr",
+///                                            std::nullopt, files);
+Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format, const std::string& label,
+                               const std::optional<RawOptions>& raw = std::nullopt,
+                               const MemoryFiles& data_files = {});
+
+/// A mesh format, for bytes that have no file name to tell it.
+enum class MeshFormat { ply, obj, stl, off };
+
+/// Reads a mesh from bytes in memory, exactly as read_mesh() reads a file of that format (which
+/// calls this). `label` stands for the file's name at the start of every message.
+/// @throws Error, as read_mesh(); never another exception type, whatever the bytes.
+Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& label);
 
 /// True for names whose extension read_volume() knows without RawOptions.
 bool has_volume_header(const std::filesystem::path& path);

@@ -66,6 +66,10 @@ public:
     Volume() = default;
     /// Allocates zeroed samples. @throws Error{too_large} if the size overflows or an axis < 1.
     Volume(ScalarType type, Index3 dims, Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0});
+    /// Takes over `samples`, which must hold exactly the type_size(type) * nx * ny * nz bytes
+    /// described (the readers fill such a buffer while checking a file, before the volume
+    /// exists). @throws Error as above, or Error{invalid_argument} for a null buffer.
+    Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin, std::unique_ptr<std::byte[]> samples);
 
     ScalarType type() const noexcept { return type_; }
     const Index3& dims() const noexcept { return dims_; }

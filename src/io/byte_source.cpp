@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstring>
 #include <limits>
+#include <new>
 #include <system_error>
 #include <utility>
 
@@ -27,10 +28,36 @@ std::string errno_text(int error)
 
 } // namespace
 
+// ---- ByteInput ------------------------------------------------------------------------------
+
+void ByteInput::read(std::uint64_t offset, void* out, std::size_t count) const
+{
+    if (offset > size_ || count > size_ - offset) {
+        throw Error(Status::truncated_file, label_ + ": " + std::to_string(count) +
+                                                " bytes at byte " + std::to_string(offset) +
+                                                " pass the end of the file (" +
+                                                std::to_string(size_) + " bytes)");
+    }
+    if (count > 0) read_checked(offset, out, count);
+}
+
+std::string ByteInput::read_string(std::uint64_t offset, std::uint64_t max_count) const
+{
+    if (offset >= size_) return {};
+    const std::uint64_t count = std::min(max_count, size_ - offset);
+    if (count > std::numeric_limits<std::size_t>::max() / 2) {
+        throw Error(Status::too_large,
+                    label_ + ": " + std::to_string(count) + " bytes cannot be held in memory");
+    }
+    std::string bytes(static_cast<std::size_t>(count), '\0');
+    read(offset, bytes.data(), bytes.size());
+    return bytes;
+}
+
 // ---- InputFile ------------------------------------------------------------------------------
 
 InputFile::InputFile(const std::filesystem::path& path, std::string label)
-    : label_(std::move(label))
+    : ByteInput(std::move(label))
 {
     // O_NONBLOCK: opening a FIFO must not wait for a writer; it is rejected below as not regular.
     do {
@@ -62,14 +89,8 @@ InputFile::~InputFile()
     if (fd_ >= 0) ::close(fd_);
 }
 
-void InputFile::read(std::uint64_t offset, void* out, std::size_t count) const
+void InputFile::read_checked(std::uint64_t offset, void* out, std::size_t count) const
 {
-    if (offset > size_ || count > size_ - offset) {
-        throw Error(Status::truncated_file, label_ + ": " + std::to_string(count) +
-                                                " bytes at byte " + std::to_string(offset) +
-                                                " pass the end of the file (" +
-                                                std::to_string(size_) + " bytes)");
-    }
     auto* dst = static_cast<unsigned char*>(out);
     std::size_t done = 0;
     while (done < count) {
@@ -92,17 +113,17 @@ void InputFile::read(std::uint64_t offset, void* out, std::size_t count) const
     }
 }
 
-std::string InputFile::read_string(std::uint64_t offset, std::uint64_t max_count) const
+// ---- MemoryInput ----------------------------------------------------------------------------
+
+MemoryInput::MemoryInput(std::string_view bytes, std::string label)
+    : ByteInput(std::move(label)), bytes_(bytes)
 {
-    if (offset >= size_) return {};
-    const std::uint64_t count = std::min(max_count, size_ - offset);
-    if (count > std::numeric_limits<std::size_t>::max() / 2) {
-        throw Error(Status::too_large,
-                    label_ + ": " + std::to_string(count) + " bytes cannot be held in memory");
-    }
-    std::string bytes(static_cast<std::size_t>(count), '\0');
-    read(offset, bytes.data(), bytes.size());
-    return bytes;
+    size_ = bytes_.size();
+}
+
+void MemoryInput::read_checked(std::uint64_t offset, void* out, std::size_t count) const
+{
+    std::memcpy(out, bytes_.data() + offset, count);
 }
 
 // ---- ByteSource -----------------------------------------------------------------------------
@@ -185,8 +206,8 @@ void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const
         declared <= compressed * kRatio + kSlack;
     if (!possible) {
         throw Error(Status::truncated_file,
-                    label + ": " + what + " (" + std::to_string(declared) +
-                        " bytes) cannot come out of the " + std::to_string(compressed) +
+                    label + ": " + what + ", which cannot come out of the " +
+                        std::to_string(compressed) +
                         " compressed bytes in the file (deflate expands at most 1032:1); "
                         "the header's sizes are wrong or the file was cut short");
     }
@@ -278,8 +299,55 @@ private:
 
 } // namespace
 
-void inflate_exact(std::string_view in, std::uint64_t skip, std::byte* out, std::size_t out_size,
-                   const std::string& label)
+namespace {
+
+/// A block of bytes that grows by doubling up to a limit, without zeroing (only the bytes
+/// written are ever touched, so the memory used follows the bytes decoded).
+class GrowingBuffer {
+public:
+    GrowingBuffer(std::size_t initial, std::size_t limit, const std::string& label)
+        : limit_(limit), label_(label)
+    {
+        reserve(std::min(initial, limit));
+    }
+
+    unsigned char* data() noexcept { return reinterpret_cast<unsigned char*>(data_.get()); }
+    std::size_t capacity() const noexcept { return capacity_; }
+    bool full() const noexcept { return capacity_ == limit_; }
+    /// Doubles the capacity (at most to the limit), keeping the first `used` bytes.
+    void grow(std::size_t used)
+    {
+        const std::size_t next = capacity_ > limit_ / 2 ? limit_ : std::max<std::size_t>(2 * capacity_, 1);
+        std::unique_ptr<std::byte[]> old = std::move(data_);
+        reserve(next);
+        std::memcpy(data_.get(), old.get(), used);
+    }
+    std::unique_ptr<std::byte[]> release() noexcept { return std::move(data_); }
+
+private:
+    void reserve(std::size_t count)
+    {
+        try {
+            data_.reset(new std::byte[std::max<std::size_t>(count, 1)]);
+        } catch (const std::bad_alloc&) {
+            throw Error(Status::too_large,
+                        label_ + ": cannot allocate " + std::to_string(count) +
+                            " bytes for the inflated samples (the header declares " +
+                            std::to_string(limit_) + ")");
+        }
+        capacity_ = count;
+    }
+
+    std::unique_ptr<std::byte[]> data_;
+    std::size_t capacity_ = 0;
+    std::size_t limit_;
+    const std::string& label_;
+};
+
+} // namespace
+
+std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t skip,
+                                           std::size_t out_size, const std::string& label)
 {
     Inflater inflater(in, label);
     const std::uint64_t wanted = skip + out_size;
@@ -303,9 +371,24 @@ void inflate_exact(std::string_view in, std::uint64_t skip, std::byte* out, std:
         got += made;
         if (made < n) fail_short();
     }
-    const std::size_t made = inflater.produce(reinterpret_cast<unsigned char*>(out), out_size);
-    got += made;
-    if (made < out_size) fail_short();
+    // Real volumes compress a few times; start at 16 times the stream (at least 1 MiB, never
+    // more than declared) and double while the stream keeps producing.
+    constexpr std::size_t kRatioGuess = 16;
+    constexpr std::size_t kMinimum = std::size_t{1} << 20;
+    const std::size_t guess = in.size() > std::numeric_limits<std::size_t>::max() / kRatioGuess
+                                  ? out_size
+                                  : std::max(kMinimum, kRatioGuess * in.size());
+    GrowingBuffer buffer(guess, out_size, label);
+    std::size_t filled = 0;
+    while (true) {
+        const std::size_t room = buffer.capacity() - filled;
+        const std::size_t made = inflater.produce(buffer.data() + filled, room);
+        filled += made;
+        got += made;
+        if (made < room) fail_short();
+        if (buffer.full()) break;
+        buffer.grow(filled);
+    }
 
     // Everything declared is there; the stream must now end (its trailer holds the checksum).
     if (!inflater.ended()) {
@@ -330,6 +413,7 @@ void inflate_exact(std::string_view in, std::uint64_t skip, std::byte* out, std:
                         std::to_string(inflater.consumed() + junk) + " of " +
                         std::to_string(in.size()) + ")");
     }
+    return buffer.release();
 }
 
 } // namespace cmc33::io::detail

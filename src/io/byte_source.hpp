@@ -1,35 +1,35 @@
 #pragma once
 // Internal: bounded access to untrusted bytes for the volume readers.
 //
-// - `InputFile`: a regular file read by (offset, count); every range is checked against the size
-// the
-//   file had when it was opened, so no read can run past its end.
+// - `ByteInput`: bytes read by (offset, count), every range checked against the size the input
+//   had when it was opened, so no read can run past its end. Two kinds: `InputFile` (a regular
+//   file) and `MemoryInput` (a buffer the caller holds); the readers see only `ByteInput`, so the
+//   file API and the in-memory API run the same parsing code.
 // - `ByteSource`: a cursor over bytes held in memory (a header); every read checks what remains.
 // - Byte order: samples are converted in place to the machine's order.
-// - Inflate: a zlib or gzip stream is inflated straight into the caller's buffer of exactly the
-//   declared size, after a check that the stream can hold that many bytes at all.
+// - Inflate: a zlib or gzip stream is inflated into a buffer that grows with the bytes actually
+//   decoded, up to the declared size, after a check that the stream can hold that many at all.
 //
 // Every error message starts with the `label` given by the caller (the file as the user named it).
 
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "cmc33/io.hpp"
 
 namespace cmc33::io::detail {
 
-/// A regular file opened for reading. Its size is taken once, when it is opened.
-class InputFile {
+/// Bytes that can be read by (offset, count). The size is fixed when the input is opened.
+class ByteInput {
 public:
-    /// Opens `path`; `label` starts every message. @throws Error{io_error} if the file is missing,
-    /// unreadable, a directory or not a regular file (a FIFO would block).
-    InputFile(const std::filesystem::path& path, std::string label);
-    ~InputFile();
-    InputFile(const InputFile&) = delete;
-    InputFile& operator=(const InputFile&) = delete;
+    virtual ~ByteInput() = default;
+    ByteInput(const ByteInput&) = delete;
+    ByteInput& operator=(const ByteInput&) = delete;
 
     const std::string& label() const noexcept { return label_; }
     std::uint64_t size() const noexcept { return size_; }
@@ -40,10 +40,36 @@ public:
     /// Reads min(max_count, size - offset) bytes at `offset` (nothing if offset >= size).
     std::string read_string(std::uint64_t offset, std::uint64_t max_count) const;
 
-private:
-    int fd_ = -1;
+protected:
+    explicit ByteInput(std::string label) : label_(std::move(label)) {}
+    /// Reads a range already checked to lie within [0, size).
+    virtual void read_checked(std::uint64_t offset, void* out, std::size_t count) const = 0;
+
     std::string label_;
     std::uint64_t size_ = 0;
+};
+
+/// A regular file opened for reading.
+class InputFile final : public ByteInput {
+public:
+    /// Opens `path`; `label` starts every message. @throws Error{io_error} if the file is missing,
+    /// unreadable, a directory or not a regular file (a FIFO would block).
+    InputFile(const std::filesystem::path& path, std::string label);
+    ~InputFile() override;
+
+private:
+    void read_checked(std::uint64_t offset, void* out, std::size_t count) const override;
+    int fd_ = -1;
+};
+
+/// Bytes held by the caller, who keeps them alive while the input is used.
+class MemoryInput final : public ByteInput {
+public:
+    MemoryInput(std::string_view bytes, std::string label);
+
+private:
+    void read_checked(std::uint64_t offset, void* out, std::size_t count) const override;
+    std::string_view bytes_;
 };
 
 /// A cursor over bytes in memory. Reads never pass the end: they report what is missing instead.
@@ -90,16 +116,21 @@ inline void to_native(std::byte* data, std::size_t count, std::size_t width, End
 
 /// Deflate expands at most about 1032:1. Throws Error{truncated_file} if `declared` bytes cannot
 /// come out of `compressed` bytes (declared > 1032 * compressed + 1024): call it before
-/// allocating anything of the declared size. `what` describes the declared size in the message.
+/// allocating anything of the declared size. `what` says what the header declares, with its size
+/// in bytes, and starts the message after the label.
 void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const std::string& label,
                          const std::string& what);
 
 /// Inflates the zlib or gzip stream in `in` (the kind is detected from its first bytes; gzip
-/// members may follow one another), discards its first `skip` bytes, and fills exactly
-/// `out_size` bytes at `out`. After the stream's end, only zero bytes may follow.
+/// members may follow one another), discards its first `skip` bytes, and returns the next
+/// `out_size` bytes, which must be all the stream holds. After the stream's end, only zero bytes
+/// may follow. The buffer grows with the bytes decoded (it starts near what the compressed size
+/// suggests and doubles, up to `out_size`), so a header that lies about the size costs no more
+/// memory than the stream really holds.
 /// @throws Error{bad_format} for corrupt data, a stream that holds more bytes, or non-zero
-/// trailing bytes; Error{truncated_file} for a stream that ends early or holds fewer bytes.
-void inflate_exact(std::string_view in, std::uint64_t skip, std::byte* out, std::size_t out_size,
-                   const std::string& label);
+/// trailing bytes; Error{truncated_file} for a stream that ends early or holds fewer bytes;
+/// Error{too_large} if the memory for the bytes decoded so far cannot be had.
+std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t skip,
+                                           std::size_t out_size, const std::string& label);
 
 } // namespace cmc33::io::detail

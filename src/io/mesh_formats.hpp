@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
 
 namespace cmc33::io::detail {
@@ -30,9 +31,6 @@ void write_obj(const Mesh& mesh, std::ostream& out);
 void write_stl(const Mesh& mesh, std::ostream& out);
 void write_off(const Mesh& mesh, std::ostream& out);
 
-/// Reads a mesh image by the extension of `name` (".ply", ".obj", ".stl", ".off").
-/// @throws Error{unsupported_format} for another extension, Error for bad content.
-Mesh read_mesh_bytes(std::string_view bytes, const std::string& name);
 
 // ---- messages -------------------------------------------------------------------------------
 
@@ -56,6 +54,13 @@ bool parse_double(std::string_view token, double& value);
 bool parse_int(std::string_view token, std::int64_t& value);
 
 // ---- text -----------------------------------------------------------------------------------
+
+/// Text meshes are lines of records, and every writer ends its lines: a file whose last line has
+/// no line end and ends in what may be part of a number (a digit, '.', '/', 'e', '+', '-'; the
+/// token starts like a number) may have been cut inside that number, so it is refused
+/// (docs/formats.md). Text after a `comment` character on that line is not looked at.
+/// @throws Error{truncated_file}.
+void check_text_end(std::string_view bytes, char comment, const std::string& name);
 
 /// Whitespace-separated tokens over a text, with line numbers. '\n' ends a line ("\r\n" too);
 /// when `comment` is not 0, a token starting with it hides the rest of its line.

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <optional>
 #include <string>
 #include <system_error>
 
@@ -155,6 +156,30 @@ std::string_view TextCursor::rest_of_line() const
     return rest;
 }
 
+void check_text_end(std::string_view bytes, char comment, const std::string& name)
+{
+    if (bytes.empty() || bytes.back() == '\n' || is_blank(bytes.back())) return;
+    const std::size_t newline = bytes.rfind('\n');
+    const std::size_t start = newline == std::string_view::npos ? 0 : newline + 1;
+    const std::string_view line = bytes.substr(start);
+    if (comment != 0 && line.find(comment) != std::string_view::npos) return;
+    std::size_t begin = line.size();
+    while (begin > 0 && !is_blank(line[begin - 1])) --begin;
+    const std::string_view token = line.substr(begin);
+    auto starts_number = [](char c) { return (c >= '0' && c <= '9') || c == '+' || c == '-' || c == '.'; };
+    auto continues_number = [](char c) {
+        return (c >= '0' && c <= '9') || c == '.' || c == '/' || c == 'e' || c == 'E' || c == '+' ||
+               c == '-';
+    };
+    if (token.empty() || !starts_number(token.front()) || !continues_number(token.back())) return;
+    std::size_t line_number = 1;
+    for (char c : bytes.substr(0, start)) line_number += c == '\n' ? 1 : 0;
+    throw Error(Status::truncated_file,
+                concat(name, ": line ", line_number, ": the file ends inside the number ",
+                       quote_text(token),
+                       " (no line end after it): cut short? A complete file ends its last line"));
+}
+
 // ---- output ---------------------------------------------------------------------------------
 
 void OutputBuffer::real(float value)
@@ -212,26 +237,16 @@ constexpr const char* kAcceptedExtensions = ".ply, .obj, .stl or .off";
                                                    "; expected ", kAcceptedExtensions));
 }
 
-bool is_mesh_extension(const std::string& ext)
+std::optional<MeshFormat> mesh_format(const std::string& ext)
 {
-    return ext == ".ply" || ext == ".obj" || ext == ".stl" || ext == ".off";
+    if (ext == ".ply") return MeshFormat::ply;
+    if (ext == ".obj") return MeshFormat::obj;
+    if (ext == ".stl") return MeshFormat::stl;
+    if (ext == ".off") return MeshFormat::off;
+    return std::nullopt;
 }
 
 } // namespace
-
-Mesh read_mesh_bytes(std::string_view bytes, const std::string& name)
-{
-    const std::string ext = lower_extension(name);
-    if (!is_mesh_extension(ext)) unsupported_extension(name, ext);
-    if (bytes.empty()) {
-        throw Error(Status::truncated_file,
-                    concat(name, ": the file is empty; expected a ", ext.substr(1), " mesh"));
-    }
-    if (ext == ".ply") return read_ply(bytes, name);
-    if (ext == ".obj") return read_obj(bytes, name);
-    if (ext == ".stl") return read_stl(bytes, name);
-    return read_off(bytes, name);
-}
 
 } // namespace detail
 
@@ -352,7 +367,7 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
 {
     const std::string name = path.string();
     const std::string ext = detail::lower_extension(path);
-    if (!detail::is_mesh_extension(ext)) detail::unsupported_extension(name, ext);
+    if (!detail::mesh_format(ext)) detail::unsupported_extension(name, ext);
     validate_for_writing(mesh, name);
     if (ext == ".stl" && mesh.triangle_count() > std::numeric_limits<std::uint32_t>::max()) {
         throw Error(Status::too_large, detail::concat(name,
@@ -373,13 +388,31 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
     });
 }
 
+Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& label)
+{
+    if (bytes.empty()) {
+        static constexpr const char* kExpected[] = {"a PLY", "an OBJ", "an STL", "an OFF"};
+        throw Error(Status::truncated_file,
+                    detail::concat(label, ": the file is empty; expected ",
+                                   kExpected[static_cast<int>(format)], " mesh"));
+    }
+    switch (format) {
+    case MeshFormat::ply: return detail::read_ply(bytes, label);
+    case MeshFormat::obj: return detail::read_obj(bytes, label);
+    case MeshFormat::stl: return detail::read_stl(bytes, label);
+    case MeshFormat::off: break;
+    }
+    return detail::read_off(bytes, label);
+}
+
 Mesh read_mesh(const std::filesystem::path& path)
 {
     const std::string name = path.string();
     const std::string ext = detail::lower_extension(path);
-    if (!detail::is_mesh_extension(ext)) detail::unsupported_extension(name, ext);
+    const std::optional<MeshFormat> format = detail::mesh_format(ext);
+    if (!format) detail::unsupported_extension(name, ext);
     const FileImage file(path);
-    return detail::read_mesh_bytes(file.bytes(), name);
+    return read_mesh_from_memory(file.bytes(), *format, name);
 }
 
 } // namespace cmc33::io

@@ -59,6 +59,7 @@ struct ObjReader {
     // Resolves a 1-based or negative index against `count` items defined so far.
     std::int64_t resolve(std::string_view text, std::size_t count, const char* what)
     {
+        const char* plural = std::string_view(what) == "vertex" ? "vertices" : "normals";
         std::int64_t index = 0;
         if (!parse_int(text, index)) {
             fail(Status::bad_format, concat(quote_text(text), " is not a ", what, " index"));
@@ -67,7 +68,7 @@ struct ObjReader {
         if (index < 0) {
             if (static_cast<std::uint64_t>(-(index + 1)) >= count) {
                 fail(Status::bad_format, concat("relative ", what, " index ", index, " but only ",
-                                                count, " ", what, "s are defined so far"));
+                                                count, " ", plural, " are defined so far"));
             }
             return static_cast<std::int64_t>(count) + index;
         }
@@ -175,6 +176,7 @@ struct ObjReader {
 
 Mesh read_obj(std::string_view bytes, const std::string& name)
 {
+    check_text_end(bytes, '#', name);
     ObjReader reader(bytes, name);
     return reader.read();
 }

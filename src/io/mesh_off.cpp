@@ -16,6 +16,7 @@ namespace cmc33::io::detail {
 
 Mesh read_off(std::string_view bytes, const std::string& name)
 {
+    check_text_end(bytes, '#', name);
     TextCursor in(bytes, '#');
     std::string_view token;
     auto fail = [&](Status status, const std::string& what) {
@@ -141,6 +142,11 @@ Mesh read_off(std::string_view bytes, const std::string& name)
             mesh.triangles.insert(mesh.triangles.end(), {polygon[0], polygon[k], polygon[k + 1]});
         }
         in.skip_line(); // a colour may follow
+    }
+    if (in.next_token(token)) {
+        fail(Status::bad_format,
+             concat(quote_text(token), " follows the last of the ", f,
+                    " faces the counts declare; more data than declared (wrong counts?)"));
     }
     return mesh;
 }

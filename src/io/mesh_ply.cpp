@@ -488,6 +488,14 @@ void read_binary(const Header& header, std::string_view bytes, Sink& sink, const
             }
         }
     }
+    if (in.remaining() > 0) {
+        throw Error(Status::bad_format,
+                    concat(name, ": ", in.remaining(),
+                           in.remaining() == 1 ? " byte follows" : " bytes follow",
+                           " the last record the header declares (at byte ",
+                           bytes.size() - in.remaining(), " of ", bytes.size(),
+                           "); more data than declared (wrong counts?)"));
+    }
 }
 
 // ---- ascii ----------------------------------------------------------------------------------
@@ -548,6 +556,12 @@ void read_ascii(const Header& header, std::string_view bytes, Sink& sink, const 
             }
         }
     }
+    if (in.next_token(token)) {
+        throw Error(Status::bad_format,
+                    concat(name, ": line ", header.lines + in.line(), ": ", quote_text(token),
+                           " follows the last record the header declares; more data than "
+                           "declared (wrong counts?)"));
+    }
 }
 
 } // namespace
@@ -560,6 +574,7 @@ Mesh read_ply(std::string_view bytes, const std::string& name)
     Mesh mesh;
     Sink sink{mesh, vertex_count, {}, 0, name};
     if (header.encoding == Encoding::ascii) {
+        check_text_end(bytes, 0, name);
         read_ascii(header, bytes, sink, name);
     } else {
         read_binary(header, bytes, sink, name);

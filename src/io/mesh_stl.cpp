@@ -245,8 +245,12 @@ Mesh read_stl(std::string_view bytes, const std::string& name)
                     concat(name, ": binary STL declares ", count, " triangles (", expected,
                            " bytes) but the file has ", bytes.size(), " bytes"));
     }
-    // Longer than declared: some writers pad the file. The declared triangles are all there.
-    return read_binary(bytes, count, name);
+    // Longer than declared (and not ASCII): a count mismatch, like any other (docs/formats.md).
+    throw Error(Status::bad_format,
+                concat(name, ": binary STL declares ", count, " triangles (", expected,
+                       " bytes) but the file has ", bytes.size(), " bytes: ",
+                       bytes.size() - expected,
+                       " more after the last triangle (wrong count, or data appended?)"));
 }
 
 void write_stl(const Mesh& mesh, std::ostream& out)

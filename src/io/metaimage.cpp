@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cmath>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -108,7 +109,8 @@ void check_identity(const Field& field, const std::string& label)
         double v = 0;
         if (!parse_real(words[i], v)) {
             throw Error(Status::bad_format, str_cat(label, ": ", field_name(field), " value ",
-                                                    quote_bytes(words[i]), " is not a number"));
+                                                    quote_bytes(words[i]), ' ',
+                                                    real_problem(words[i])));
         }
         const double expected = i % 4 == 0 ? 1.0 : 0.0;
         if (!(std::fabs(v - expected) <= 1e-6)) {
@@ -137,9 +139,9 @@ std::string met_type_name(ScalarType type)
 
 } // namespace
 
-Volume read_metaimage(const std::filesystem::path& path, const std::string& label)
+Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
 {
-    InputFile file(path, label);
+    const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "MetaImage");
     ByteSource source(head);
 
@@ -222,6 +224,7 @@ Volume read_metaimage(const std::filesystem::path& path, const std::string& labe
     const Field& dims = require(fields, "dimsize", "DimSize", label);
     grid.dims = parse_dims(split_words(dims.value), label, field_name(dims));
     grid.type = parse_element_type(require(fields, "elementtype", "ElementType", label), label);
+    payload_bytes(grid.dims, grid.type, label); // size errors name the header, not the data file
     const Field* spacing = find(fields, "elementspacing");
     if (spacing == nullptr) spacing = find(fields, "elementsize");
     if (spacing)
@@ -274,9 +277,8 @@ Volume read_metaimage(const std::filesystem::path& path, const std::string& labe
         throw Error(Status::bad_format, str_cat(label, ": ElementDataFile (line ", data_file->line,
                                                 ") names no file; expected LOCAL or a file name"));
     }
-    const std::filesystem::path data_path = resolve_data_file(path, name);
-    const std::string data_label = str_cat(label, ": data file ", data_path.string());
-    const InputFile data(data_path, data_label);
+    const std::unique_ptr<ByteInput> data_input = open_data(name);
+    const ByteInput& data = *data_input;
     if (const Field* header_size = find(fields, "headersize")) {
         const std::int64_t skip = parse_int_field(*header_size, label);
         if (skip < -1 || (skip == -1 && storage.encoding != Encoding::raw)) {
@@ -291,7 +293,7 @@ Volume read_metaimage(const std::filesystem::path& path, const std::string& labe
             storage.offset = static_cast<std::uint64_t>(skip);
         }
     }
-    return read_samples(data, grid, storage, data_label);
+    return read_samples(data, grid, storage, data.label());
 }
 
 void write_metaimage(const Volume& volume, const std::filesystem::path& path, bool local)

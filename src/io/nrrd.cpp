@@ -9,6 +9,7 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -179,7 +180,8 @@ parse_vectors(const Field& field, std::string_view name, const std::string& labe
             if (!parse_real(token, value)) {
                 throw Error(Status::bad_format,
                             str_cat(label, ": field \"", name, "\" (line ", field.line,
-                                    "): component ", quote_bytes(token), " is not a number"));
+                                    "): component ", quote_bytes(token), ' ',
+                                    real_problem(token)));
             }
             if (!std::isfinite(value)) {
                 throw Error(Status::non_finite,
@@ -222,6 +224,22 @@ Vec3 parse_space_directions(const Field& field, const std::string& label)
         // Axis-aligned: the other two components vanish (up to rounding in the writer).
         const bool aligned = norm > 0 && std::fabs(v[(axis + 1) % 3]) <= 1e-9 * norm &&
                              std::fabs(v[(axis + 2) % 3]) <= 1e-9 * norm;
+        // One non-zero component elsewhere than on the diagonal: the axes are permuted, which
+        // is axis-aligned but not the sample order cmc33 reads.
+        std::size_t along = 3;
+        for (std::size_t c = 0; c < 3; ++c) {
+            const bool others_vanish = std::fabs(v[(c + 1) % 3]) <= 1e-9 * norm &&
+                                       std::fabs(v[(c + 2) % 3]) <= 1e-9 * norm;
+            if (norm > 0 && others_vanish) along = c;
+        }
+        if (!aligned && along != 3) {
+            throw Error(Status::unsupported_format,
+                        str_cat(label, ": space directions ", quote_bytes(field.value, 80),
+                                " (line ", field.line, ") permute the axes (sample axis ",
+                                axis + 1, " runs along space axis ", along + 1,
+                                "); cmc33 reads only diagonal directions like (sx,0,0) "
+                                "(0,sy,0) (0,0,sz)"));
+        }
         if (!aligned) {
             throw Error(Status::unsupported_format,
                         str_cat(label, ": space directions ", quote_bytes(field.value, 80),
@@ -259,7 +277,7 @@ std::int64_t parse_skip(const Field& field, std::string_view name, std::int64_t 
 }
 
 /// The offset after `lines` more line ends, counted from `offset`.
-std::uint64_t skip_lines(const InputFile& file, std::uint64_t offset, std::int64_t lines,
+std::uint64_t skip_lines(const ByteInput& file, std::uint64_t offset, std::int64_t lines,
                          const std::string& label)
 {
     std::int64_t seen = 0;
@@ -293,9 +311,9 @@ std::string nrrd_type_name(ScalarType type)
 
 } // namespace
 
-Volume read_nrrd(const std::filesystem::path& path, const std::string& label)
+Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header)
 {
-    InputFile file(path, label);
+    const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "NRRD");
     ByteSource source(head);
 
@@ -372,7 +390,7 @@ Volume read_nrrd(const std::filesystem::path& path, const std::string& label)
                         str_cat(label, ": no empty line ends the NRRD header within its first ",
                                 kMaxHeaderBytes, " bytes"));
         }
-        if (data_file == nullptr && lower_extension(path) == ".nhdr") {
+        if (data_file == nullptr && detached_header) {
             throw Error(Status::bad_format,
                         str_cat(label, ": the detached header (.nhdr) has no \"data file\" field"));
         }
@@ -399,6 +417,7 @@ Volume read_nrrd(const std::filesystem::path& path, const std::string& label)
     grid.type = parse_nrrd_type(require(fields, "type", label), label);
     const Field& sizes = require(fields, "sizes", label);
     grid.dims = parse_dims(split_words(sizes.value), label, "field \"sizes\"");
+    payload_bytes(grid.dims, grid.type, label); // size errors name the header, not the data file
 
     Storage storage;
     storage.encoding = parse_encoding(require(fields, "encoding", label), label);
@@ -433,8 +452,7 @@ Volume read_nrrd(const std::filesystem::path& path, const std::string& label)
         grid.origin = parse_space_origin(*origin, label);
 
     // Where the samples are.
-    std::optional<InputFile> detached;
-    std::string data_label = label;
+    std::unique_ptr<ByteInput> detached;
     if (data_file) {
         const std::string name(trim(data_file->value));
         if (is_file_pattern(name)) {
@@ -448,14 +466,13 @@ Volume read_nrrd(const std::filesystem::path& path, const std::string& label)
             throw Error(Status::bad_format, str_cat(label, ": field \"data file\" (line ",
                                                     data_file->line, ") names no file"));
         }
-        const std::filesystem::path data_path = resolve_data_file(path, name);
-        data_label = str_cat(label, ": data file ", data_path.string());
-        detached.emplace(data_path, data_label);
-    } else if (lower_extension(path) == ".nhdr") {
+        detached = open_data(name);
+    } else if (detached_header) {
         throw Error(Status::bad_format,
                     str_cat(label, ": the detached header (.nhdr) has no \"data file\" field"));
     }
-    const InputFile& data = detached ? *detached : file;
+    const ByteInput& data = detached ? *detached : file;
+    const std::string& data_label = data.label();
     storage.offset = detached ? 0 : source.position();
     if (const Field* lines = find(fields, "line skip")) {
         storage.offset =

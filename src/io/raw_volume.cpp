@@ -13,10 +13,9 @@
 
 namespace cmc33::io::detail {
 
-Volume read_raw(const std::filesystem::path& path, const std::string& label,
-                const std::optional<RawOptions>& raw)
+Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw)
 {
-    const InputFile file(path, label);
+    const std::string& label = file.label();
     if (!raw) {
         throw Error(Status::invalid_argument,
                     label + ": headerless raw volume needs --dims X Y Z and --type T");

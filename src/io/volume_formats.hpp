@@ -4,8 +4,12 @@
 //
 // A reader parses its header into a `Grid` (type, dims, spacing, origin) and a `Storage` (where
 // the samples are and how they are coded), then read_samples() checks the declared size against
-// the bytes the file holds *before* allocating the volume, reads or inflates the samples straight
-// into it and converts them to the machine's byte order.
+// the bytes the input holds *before* allocating the volume, reads or inflates the samples into it
+// and converts them to the machine's byte order. Readers see a `ByteInput` (a file or a buffer)
+// and open data files through an `OpenDataFile`, so files and memory share one code path.
+//
+// One policy for what the bytes say against the header (docs/formats.md): fewer or more samples,
+// values or bytes than declared is an error; blanks after the last ASCII value, or none, are not.
 //
 // Messages start with `label`: the file as the user named it, then ": data file X" when the
 // samples are in a second file, then ": " and what is wrong.
@@ -13,6 +17,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <sstream>
@@ -57,6 +63,8 @@ std::string dims_text(const Index3& dims);
 
 /// The whole token is a decimal number (a leading '+' is accepted; "nan", "inf" too).
 bool parse_real(std::string_view token, double& value);
+/// Why parse_real refused `token`: "is out of the double range ..." or "is not a number".
+std::string real_problem(std::string_view token);
 /// The whole token is a decimal integer (a leading '+' is accepted).
 bool parse_integer(std::string_view token, std::int64_t& value);
 
@@ -76,7 +84,7 @@ std::uint64_t payload_bytes(const Index3& dims, ScalarType type, const std::stri
 
 /// The start of `file` (at most kMaxHeaderBytes), for parsing a header.
 /// @throws Error{truncated_file} for an empty file (`format` names what was expected).
-std::string read_header_bytes(const InputFile& file, std::string_view format);
+std::string read_header_bytes(const ByteInput& file, std::string_view format);
 
 /// `name` from a header, relative to the header's folder unless absolute.
 std::filesystem::path resolve_data_file(const std::filesystem::path& header, std::string_view name);
@@ -107,27 +115,39 @@ struct Storage {
     bool at_end = false;                      ///< raw: the samples are the file's last bytes
     std::optional<std::uint64_t> stored_size; ///< compressed: the stream's bytes, if declared
     std::uint64_t skip_inflated = 0;          ///< compressed: output bytes to discard first
+    /// What may follow the samples: nothing (blanks after ASCII values), or anything, for a
+    /// reader that checks the rest itself (VTK: further attributes).
+    bool check_trailing = true;
 };
 
 /// Reads the samples `grid` declares from `file` as `storage` says. Checks the sizes against the
-/// file before allocating. `label` starts the messages.
-Volume read_samples(const InputFile& file, const Grid& grid, const Storage& storage,
-                    const std::string& label);
+/// file before allocating. `label` starts the messages. `end`, if given, receives the offset just
+/// past the samples (raw: the last sample byte; ASCII: the last value; compressed: the stream).
+/// @throws Error{truncated_file} for fewer bytes or values than declared, Error{bad_format} for
+/// more (unless `storage.check_trailing` is false).
+Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                    const std::string& label, std::uint64_t* end = nullptr);
 
-/// Fills `volume` from decimal text; the last value must be followed by a blank.
+/// Fills `volume` from decimal text: blank-separated values, the last one followed by blanks or
+/// by the end of the text. Returns the offset just past the last value.
 /// @throws Error{truncated_file} (too few values), Error{bad_format} (not a number, out of range).
-void parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label);
+std::size_t parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label);
 
 /// Writes the samples in `endian` order (in blocks, swapping a copy when needed).
 void write_samples(std::ostream& out, const Volume& volume, Endian endian);
 
 // ---- formats --------------------------------------------------------------------------------
 
-Volume read_nrrd(const std::filesystem::path& path, const std::string& label);
-Volume read_metaimage(const std::filesystem::path& path, const std::string& label);
-Volume read_vtk(const std::filesystem::path& path, const std::string& label);
-Volume read_raw(const std::filesystem::path& path, const std::string& label,
-                const std::optional<RawOptions>& raw);
+/// Opens the data file a detached header names (`name` as the header writes it). The input's
+/// label says "<header>: data file <name>". @throws Error{io_error} if there is no such file.
+using OpenDataFile = std::function<std::unique_ptr<ByteInput>(std::string_view name)>;
+
+/// NRRD, attached or detached; `detached_header` (a .nhdr file) requires a "data file" field.
+Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header);
+/// MetaImage, .mha (ElementDataFile = LOCAL) or .mhd (a data file).
+Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data);
+Volume read_vtk(const ByteInput& file);
+Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw);
 
 /// The data file a detached header names: "<stem>.raw" in the header's folder.
 std::filesystem::path data_file_beside(const std::filesystem::path& header);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <type_traits>
 
 #include "cmc33/io.hpp"
@@ -112,6 +113,15 @@ std::string dims_text(const Index3& dims)
 
 namespace {
 
+template <class T> std::string range_text()
+{
+    if constexpr (std::is_floating_point_v<T>) {
+        return str_cat("+-", std::numeric_limits<T>::max());
+    } else {
+        return str_cat(+std::numeric_limits<T>::lowest(), "..", +std::numeric_limits<T>::max());
+    }
+}
+
 std::string_view without_leading_plus(std::string_view token) noexcept
 {
     if (token.size() > 1 && token[0] == '+' && token[1] != '-' && token[1] != '+')
@@ -173,6 +183,14 @@ bool parse_real(std::string_view token, double& value)
     return parse_floating(token, value) == Parsed::ok;
 }
 
+std::string real_problem(std::string_view token)
+{
+    double value = 0;
+    if (parse_floating(token, value) == Parsed::out_of_range)
+        return "is out of the double range " + range_text<double>();
+    return "is not a number";
+}
+
 bool parse_integer(std::string_view token, std::int64_t& value)
 {
     return parse_int64(token, value) == Parsed::ok;
@@ -217,7 +235,8 @@ Vec3 parse_vec3(const std::vector<std::string_view>& words, const std::string& l
     for (std::size_t axis = 0; axis < 3; ++axis) {
         if (!parse_real(words[axis], v[axis])) {
             throw Error(Status::bad_format, str_cat(label, ": ", what, " value ",
-                                                    quote_bytes(words[axis]), " is not a number"));
+                                                    quote_bytes(words[axis]), ' ',
+                                                    real_problem(words[axis])));
         }
         if (!std::isfinite(v[axis])) {
             throw Error(Status::non_finite, str_cat(label, ": ", what, " value ",
@@ -258,7 +277,7 @@ std::uint64_t payload_bytes(const Index3& dims, ScalarType type, const std::stri
     return bytes;
 }
 
-std::string read_header_bytes(const InputFile& file, std::string_view format)
+std::string read_header_bytes(const ByteInput& file, std::string_view format)
 {
     if (file.size() == 0) {
         throw Error(
@@ -306,18 +325,9 @@ std::string declared(const Grid& grid, std::uint64_t bytes)
                    " bytes)");
 }
 
-template <class T> std::string range_text()
-{
-    if constexpr (std::is_floating_point_v<T>) {
-        return str_cat("+-", std::numeric_limits<T>::max());
-    } else {
-        return str_cat(+std::numeric_limits<T>::lowest(), "..", +std::numeric_limits<T>::max());
-    }
-}
-
 template <class T>
-void parse_ascii_typed(std::string_view text, T* out, std::int64_t count, ScalarType type,
-                       const std::string& label)
+std::size_t parse_ascii_typed(std::string_view text, T* out, std::int64_t count, ScalarType type,
+                              const std::string& label)
 {
     std::size_t pos = 0;
     const std::size_t size = text.size();
@@ -331,16 +341,11 @@ void parse_ascii_typed(std::string_view text, T* out, std::int64_t count, Scalar
         std::size_t end = pos;
         while (end < size && !is_blank(text[end])) ++end;
         const std::string_view token = text.substr(pos, end - pos);
-        if (end == size) {
-            if (i + 1 < count) {
-                throw Error(Status::truncated_file, str_cat(label, ": the header declares ", count,
-                                                            " values but the data ends after ",
-                                                            i + 1, " (file cut short?)"));
-            }
-            throw Error(Status::truncated_file,
-                        str_cat(label, ": the file ends inside a number: the last value ",
-                                quote_bytes(token),
-                                " is not followed by a blank or a newline (file cut short?)"));
+        // The last value may end the file without a newline: the count is the evidence.
+        if (end == size && i + 1 < count) {
+            throw Error(Status::truncated_file, str_cat(label, ": the header declares ", count,
+                                                        " values but the data ends after ", i + 1,
+                                                        " (file cut short?)"));
         }
         Parsed parsed = Parsed::not_number;
         if constexpr (std::is_floating_point_v<T>) {
@@ -377,21 +382,22 @@ void parse_ascii_typed(std::string_view text, T* out, std::int64_t count, Scalar
         }
         pos = end;
     }
+    return pos;
 }
 
 } // namespace
 
-void parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label)
+std::size_t parse_ascii_samples(std::string_view text, Volume& volume, const std::string& label)
 {
-    dispatch_scalar_type(volume.type(), [&](auto tag) {
+    return dispatch_scalar_type(volume.type(), [&](auto tag) {
         using T = decltype(tag);
-        parse_ascii_typed<T>(text, volume.samples<T>(), volume.sample_count(), volume.type(),
-                             label);
+        return parse_ascii_typed<T>(text, volume.samples<T>(), volume.sample_count(),
+                                    volume.type(), label);
     });
 }
 
-Volume read_samples(const InputFile& file, const Grid& grid, const Storage& storage,
-                    const std::string& label)
+Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                    const std::string& label, std::uint64_t* end)
 {
     const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
     const std::uint64_t size = file.size();
@@ -411,11 +417,18 @@ Volume read_samples(const InputFile& file, const Grid& grid, const Storage& stor
                                 " bytes follow byte ", storage.offset,
                                 " (file cut short, or wrong sizes?)"));
         }
+        if (available > bytes && !storage.at_end && storage.check_trailing) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": ", declared(grid, bytes), " but ", available,
+                                " bytes follow byte ", storage.offset, ": ", available - bytes,
+                                " more after the samples (wrong sizes, or data appended?)"));
+        }
         const std::uint64_t offset = storage.at_end ? size - bytes : storage.offset;
         Volume volume = allocate(grid, label);
         file.read(offset, volume.bytes(), volume.byte_size());
         to_native(volume.bytes(), static_cast<std::size_t>(volume.sample_count()), width,
                   storage.endian);
+        if (end) *end = offset + bytes;
         return volume;
     }
     case Encoding::compressed: {
@@ -430,18 +443,36 @@ Volume read_samples(const InputFile& file, const Grid& grid, const Storage& stor
             }
             stream = *storage.stored_size;
         }
-        // Nothing of the declared size is allocated unless the stream could hold it.
-        check_inflate_bound(stream, storage.skip_inflated + bytes, label, declared(grid, bytes));
+        // Nothing of the declared size is allocated unless the stream could hold it, and then
+        // only as much as the stream really yields.
+        const std::uint64_t inflated = storage.skip_inflated + bytes;
+        check_inflate_bound(stream, inflated,
+                            label, storage.skip_inflated == 0
+                                       ? declared(grid, bytes)
+                                       : str_cat(declared(grid, bytes), " after ",
+                                                 storage.skip_inflated, " skipped bytes (",
+                                                 inflated, " in all)"));
         const std::string compressed = file.read_string(storage.offset, stream);
-        Volume volume = allocate(grid, label);
-        inflate_exact(compressed, storage.skip_inflated, volume.bytes(), volume.byte_size(), label);
-        to_native(volume.bytes(), static_cast<std::size_t>(volume.sample_count()), width,
-                  storage.endian);
-        return volume;
+        std::unique_ptr<std::byte[]> samples = inflate_exact(
+            compressed, storage.skip_inflated, static_cast<std::size_t>(bytes), label);
+        if (stream < available && storage.check_trailing) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": the header declares ", stream,
+                                " compressed bytes but ", available, " follow byte ",
+                                storage.offset, ": ", available - stream,
+                                " more after the stream (wrong compressed size?)"));
+        }
+        to_native(samples.get(), static_cast<std::size_t>(bytes / width), width, storage.endian);
+        if (end) *end = storage.offset + stream;
+        try {
+            return Volume(grid.type, grid.dims, grid.spacing, grid.origin, std::move(samples));
+        } catch (const Error& e) {
+            throw Error(e.status(), label + ": " + e.what());
+        }
     }
     case Encoding::ascii: {
-        // Each value takes at least two bytes (a digit and a blank; the last one's blank is checked
-        // while parsing, to say "ends inside a number"): check before allocating.
+        // Each value takes at least two bytes (a digit and a blank), the last one at least one:
+        // check before allocating.
         const auto count = static_cast<std::uint64_t>(grid.dims[0]) *
                            static_cast<std::uint64_t>(grid.dims[1]) *
                            static_cast<std::uint64_t>(grid.dims[2]);
@@ -454,7 +485,20 @@ Volume read_samples(const InputFile& file, const Grid& grid, const Storage& stor
         }
         const std::string text = file.read_string(storage.offset, available);
         Volume volume = allocate(grid, label);
-        parse_ascii_samples(text, volume, label);
+        const std::size_t stop = parse_ascii_samples(text, volume, label);
+        if (storage.check_trailing) {
+            const std::size_t extra = text.find_first_not_of(" \t\n\r\v\f", stop);
+            if (extra != std::string::npos) {
+                throw Error(Status::bad_format,
+                            str_cat(label, ": the header declares ", count,
+                                    " values but more follow: ",
+                                    quote_bytes(split_words(std::string_view(text).substr(
+                                                    extra, 64)).front()),
+                                    " at byte ", storage.offset + extra,
+                                    " (wrong sizes, or data appended?)"));
+            }
+        }
+        if (end) *end = storage.offset + stop;
         return volume;
     }
     }
@@ -529,10 +573,41 @@ Volume read_volume(const std::filesystem::path& path, const std::optional<RawOpt
 {
     const std::string label = path.string();
     const std::string ext = detail::lower_extension(path);
-    if (ext == ".nrrd" || ext == ".nhdr") return detail::read_nrrd(path, label);
-    if (ext == ".mhd" || ext == ".mha") return detail::read_metaimage(path, label);
-    if (ext == ".vtk") return detail::read_vtk(path, label);
-    return detail::read_raw(path, label, raw);
+    const detail::InputFile file(path, label);
+    // Data files are named relative to the header's folder.
+    const detail::OpenDataFile open_data = [&](std::string_view name) {
+        const std::filesystem::path data = detail::resolve_data_file(path, name);
+        return std::make_unique<detail::InputFile>(data, label + ": data file " + data.string());
+    };
+    if (ext == ".nrrd" || ext == ".nhdr") return detail::read_nrrd(file, open_data, ext == ".nhdr");
+    if (ext == ".mhd" || ext == ".mha") return detail::read_metaimage(file, open_data);
+    if (ext == ".vtk") return detail::read_vtk(file);
+    return detail::read_raw(file, raw);
+}
+
+Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format,
+                               const std::string& label, const std::optional<RawOptions>& raw,
+                               const MemoryFiles& data_files)
+{
+    const detail::MemoryInput input(bytes, label);
+    const detail::OpenDataFile open_data =
+        [&](std::string_view name) -> std::unique_ptr<detail::ByteInput> {
+        const std::string data_label = label + ": data file " + std::string(name);
+        const std::optional<std::string_view> data =
+            data_files ? data_files(name) : std::optional<std::string_view>();
+        if (!data) {
+            throw Error(Status::io_error,
+                        data_label + ": no such file among the data files given in memory");
+        }
+        return std::make_unique<detail::MemoryInput>(*data, data_label);
+    };
+    switch (format) {
+    case VolumeFormat::nrrd: return detail::read_nrrd(input, open_data, false);
+    case VolumeFormat::metaimage: return detail::read_metaimage(input, open_data);
+    case VolumeFormat::vtk: return detail::read_vtk(input);
+    case VolumeFormat::raw: break;
+    }
+    return detail::read_raw(input, raw);
 }
 
 void write_volume(const Volume& volume, const std::filesystem::path& path)

@@ -146,11 +146,41 @@ private:
     std::size_t number_ = 0;
 };
 
+/// After the samples: blanks, then the end of the file or another section (an attribute, FIELD,
+/// CELL_DATA, METADATA), which is not read. Anything else means more samples than declared.
+void check_after_samples(const ByteInput& file, std::uint64_t end, std::int64_t samples,
+                         const std::string& label)
+{
+    std::uint64_t pos = end;
+    std::string chunk;
+    std::size_t word = std::string::npos;
+    while (word == std::string::npos) {
+        chunk = file.read_string(pos, 1 << 12);
+        if (chunk.empty()) return;
+        word = chunk.find_first_not_of(" \t\r\n\v\f");
+        if (word == std::string::npos) pos += chunk.size();
+    }
+    pos += word;
+    // A keyword longer than the chunk's rest is read again from its start.
+    chunk = file.read_string(pos, 64);
+    const std::string_view next = split_words(chunk).front();
+    if (equals_ignore_case(next, "SCALARS") || equals_ignore_case(next, "POINT_DATA") ||
+        equals_ignore_case(next, "CELL_DATA") || equals_ignore_case(next, "METADATA") ||
+        one_of(next, kAttributes)) {
+        return;
+    }
+    throw Error(Status::bad_format,
+                str_cat(label, ": after the ", samples, " samples POINT_DATA declares, ",
+                        quote_bytes(chunk, 16), " follows at byte ", pos,
+                        "; expected the end of the file or another attribute (SCALARS, VECTORS, "
+                        "FIELD, CELL_DATA, ...): more samples than declared?"));
+}
+
 } // namespace
 
-Volume read_vtk(const std::filesystem::path& path, const std::string& label)
+Volume read_vtk(const ByteInput& file)
 {
-    InputFile file(path, label);
+    const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "VTK legacy");
     HeaderLines lines(head, label);
 
@@ -268,7 +298,11 @@ Volume read_vtk(const std::filesystem::path& path, const std::string& label)
     storage.encoding = binary ? Encoding::raw : Encoding::ascii;
     storage.endian = Endian::big;
     storage.offset = source.position();
-    return read_samples(file, grid, storage, label);
+    storage.check_trailing = false; // other attributes may follow: checked here
+    std::uint64_t end = 0;
+    Volume volume = read_samples(file, grid, storage, label, &end);
+    check_after_samples(file, end, expected, label);
+    return volume;
 }
 
 void write_vtk(const Volume& volume, const std::filesystem::path& path)

@@ -16,6 +16,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
+#include "io/atomic_file.hpp"
 #include "io/mesh_formats.hpp"
 #include "test_support.hpp"
 
@@ -33,7 +34,13 @@ using Floats = cmc33::Buffer<float>;
 Mesh read_bytes(const std::string& bytes, const std::string& name)
 {
     const std::vector<char> exact(bytes.begin(), bytes.end());
-    return detail::read_mesh_bytes(std::string_view(exact.data(), exact.size()), name);
+    const std::string ext = detail::lower_extension(name);
+    const cmc33::io::MeshFormat format = ext == ".ply"   ? cmc33::io::MeshFormat::ply
+                                         : ext == ".obj" ? cmc33::io::MeshFormat::obj
+                                         : ext == ".stl" ? cmc33::io::MeshFormat::stl
+                                                         : cmc33::io::MeshFormat::off;
+    return cmc33::io::read_mesh_from_memory(std::string_view(exact.data(), exact.size()), format,
+                                            name);
 }
 
 void expect_error(const std::string& bytes, const std::string& name, Status status,
@@ -420,10 +427,9 @@ TEST(StlReader, BinaryThatStartsWithSolid)
     EXPECT_EQ(mesh.vertex_count(), 4u);
     EXPECT_EQ(mesh.triangles, (Indices{0, 1, 2, 2, 1, 3}));
 
-    // Padded after the declared facets: accepted when it does not look like ASCII.
-    const Mesh padded =
-        read_bytes(binary_stl("x", {{0, 0, 0, 1, 0, 0, 0, 1, 0}}) + std::string(7, '\0'), "p.stl");
-    EXPECT_EQ(padded.triangle_count(), 1u);
+    // Longer than the declared facets (and not ASCII): a count mismatch (docs/formats.md).
+    expect_error(binary_stl("x", {{0, 0, 0, 1, 0, 0, 0, 1, 0}}) + std::string(7, '\0'), "p.stl",
+                 Status::bad_format, "declares 1 triangles (134 bytes) but the file has 141 bytes");
     // NaN coordinates are kept (and weld by bits).
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const Mesh with_nan = read_bytes(binary_stl("x", {{nan, 0, 0, 1, 0, 0, nan, 0, 0}}), "n.stl");
@@ -566,7 +572,76 @@ TEST(MeshTruncation, EveryCutFileThroughReadMesh)
     }
 }
 
-// Text files cut anywhere may still be valid (a shorter last number); they must either read or
+// PLY and OFF declare their counts and end every record with a line end: every cut is refused,
+// a cut inside the last number too (docs/formats.md).
+TEST(MeshTruncation, EveryCutOfAsciiPlyAndOffThrows)
+{
+    for (const char* file : {"t.ply", "t.off"}) {
+        const std::string whole = written(small_mesh(false), file, true);
+        ASSERT_EQ(whole.back(), '\n');
+        ASSERT_NO_THROW(read_bytes(whole, file));
+        for (std::size_t n = 0; n < whole.size(); ++n) {
+            EXPECT_THROW(read_bytes(whole.substr(0, n), file), Error)
+                << file << " cut at " << n << " of " << whole.size();
+        }
+    }
+}
+
+// #9 item 7: the last index "12" cut to "1" used to read as a different mesh.
+TEST(MeshTruncation, CutInsideTheLastNumberIsRefused)
+{
+    const std::string ply = "ply\nformat ascii 1.0\nelement vertex 13\nproperty float x\n"
+                            "property float y\nproperty float z\nelement face 1\n"
+                            "property list uchar int vertex_indices\nend_header\n" +
+                            [] {
+                                std::string v;
+                                for (int i = 0; i < 13; ++i) v += std::to_string(i) + " 0 " + std::to_string(i % 2) + "\n";
+                                return v;
+                            }() +
+                            "3 10 11 12\n";
+    EXPECT_EQ(read_bytes(ply, "m.ply").triangles, (Indices{10, 11, 12}));
+    expect_error(ply.substr(0, ply.size() - 2), "m.ply", Status::truncated_file,
+                 "line 23: the file ends inside the number \"1\"");
+    expect_error(ply.substr(0, ply.size() - 1), "m.ply", Status::truncated_file,
+                 "ends inside the number \"12\"");
+    // A blank after the last value, or a line end, ends it.
+    EXPECT_NO_THROW(read_bytes(ply.substr(0, ply.size() - 1) + " ", "m.ply"));
+
+    const std::string off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    expect_error(off.substr(0, off.size() - 1), "m.off", Status::truncated_file,
+                 "line 6: the file ends inside the number \"2\"");
+    EXPECT_NO_THROW(read_bytes(off + "# no line end after this comment 7", "m.off"));
+
+    // OBJ declares no counts: the last line must end unless it ends in a word or a comment.
+    const std::string obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n";
+    EXPECT_EQ(read_bytes(obj, "m.obj").triangle_count(), 2u);
+    expect_error(obj.substr(0, obj.size() - 1), "m.obj", Status::truncated_file,
+                 "line 6: the file ends inside the number \"3\"");
+    expect_error("v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3/", "m.obj",
+                 Status::truncated_file, "ends inside the number \"3/\"");
+    expect_error("v 0 0 0\nv 1 0 0\nv 0 1 2.5e", "m.obj", Status::truncated_file,
+                 "\"2.5e\"");
+    EXPECT_EQ(read_bytes(obj + "usemtl stone", "m.obj").triangle_count(), 2u);
+    EXPECT_EQ(read_bytes(obj + "# end 2", "m.obj").triangle_count(), 2u);
+}
+
+// More records, values or bytes than a header declares is an error, like fewer.
+TEST(MeshTruncation, MoreDataThanDeclaredIsRefused)
+{
+    const std::string ascii = written(small_mesh(false), "t.ply", true);
+    expect_error(ascii + "3 0 1 2\n", "t.ply", Status::bad_format,
+                 "\"3\" follows the last record the header declares");
+    EXPECT_NO_THROW(read_bytes(ascii + "\n\n  \n", "t.ply"));
+    const std::string binary = written(small_mesh(false), "t.ply", false);
+    expect_error(binary + "\n", "t.ply", Status::bad_format,
+                 "1 byte follows the last record the header declares");
+    const std::string off = written(small_mesh(false), "t.off");
+    expect_error(off + "3 0 1 2\n", "t.off", Status::bad_format,
+                 "follows the last of the");
+    EXPECT_NO_THROW(read_bytes(off + "# a comment\n\n", "t.off"));
+}
+
+// OBJ (no counts) cut anywhere may still be valid (whole lines gone); it must either read or
 // throw cmc33::Error, never anything else and never read out of bounds.
 TEST(MeshTruncation, EveryCutOfTextFormatsReadsOrThrowsError)
 {

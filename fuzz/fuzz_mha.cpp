@@ -1,0 +1,15 @@
+// libFuzzer target: MetaImage with ElementDataFile = LOCAL, from memory.
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size)
+{
+    const std::string_view bytes(reinterpret_cast<const char*>(data), size);
+    return cmc33::fuzz::run("fuzz.mha", [&] {
+        return cmc33::io::read_volume_from_memory(bytes, cmc33::io::VolumeFormat::metaimage, "fuzz.mha");
+    });
+}
