@@ -57,21 +57,27 @@ void run_extract(const ExtractArgs& args)
     for (int r = 0; r < args.repeat; ++r) {
         mesh = Mesh{}; // free the previous run's mesh before the next one allocates
         stats = ExtractStats{};
-        try {
-            const auto start = std::chrono::steady_clock::now();
-            mesh = extract(volume, args.iso, options, &stats);
-            const auto stop = std::chrono::steady_clock::now();
-            runs.push_back(std::chrono::duration<double>(stop - start).count());
-        } catch (const Error& e) {
-            rethrow_naming(e, args.input);
-        }
+        const auto start = std::chrono::steady_clock::now();
+        mesh = named_step(args.input, "extracting the mesh", [&] { return extract(volume, args.iso, options, &stats); });
+        const auto stop = std::chrono::steady_clock::now();
+        runs.push_back(std::chrono::duration<double>(stop - start).count());
     }
     const double seconds = median(runs);
     MeshTopology topology;
     MeshGeometry geometry;
-    if (!args.no_topology) topology = mesh_topology(mesh);
-    if (!args.no_topology) geometry = mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8});
-    if (!args.output.empty()) io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii});
+    if (!args.no_topology) {
+        topology = named_step(args.input, "computing the mesh's topology (about 24 bytes per triangle; "
+                                          "--no-topology skips it)",
+                              [&] { return mesh_topology(mesh); });
+    }
+    if (!args.no_topology) {
+        geometry = named_step(args.input, "checking the mesh's geometry",
+                              [&] { return mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8}); });
+    }
+    if (!args.output.empty()) {
+        named_step(args.output, "writing the mesh",
+                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii}); });
+    }
 
     const int threads = args.threads > 0 ? args.threads
                                          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));

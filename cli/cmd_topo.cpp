@@ -23,10 +23,10 @@ const char* yes_no(bool b) { return b ? "yes" : "no"; }
 
 void run_topo(const TopoArgs& args)
 {
-    const Mesh mesh = io::read_mesh(args.input);
-    const MeshTopology t = mesh_topology(mesh);
+    const Mesh mesh = named_step(args.input, "reading the mesh", [&] { return io::read_mesh(args.input); });
+    const MeshTopology t = named_step(args.input, "computing the mesh's topology", [&] { return mesh_topology(mesh); });
     MeshGeometry g;
-    if (args.geometry) g = mesh_geometry(mesh);
+    if (args.geometry) g = named_step(args.input, "checking the mesh's geometry", [&] { return mesh_geometry(mesh); });
     if (args.json) {
         Json out{{"file", args.input},
                  {"vertices", t.vertices},

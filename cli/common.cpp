@@ -103,7 +103,7 @@ Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
             throw UsageError("--dims/--type are for headerless raw files; " + path +
                              " has a header that gives its dimensions and type");
         }
-        return io::read_volume(path);
+        return named_step(path, "reading the volume", [&] { return io::read_volume(path); });
     }
     const bool has_dims = !raw.dims.empty(), has_type = !raw.type.empty();
     if (!has_dims || !has_type) {
@@ -125,7 +125,7 @@ Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
     if (!raw.spacing.empty()) options.spacing = {raw.spacing[0], raw.spacing[1], raw.spacing[2]};
     options.endian = raw.endian == "big" ? io::Endian::big : io::Endian::little;
     options.header_bytes = raw.header_bytes;
-    return io::read_volume(path, options);
+    return named_step(path, "reading the volume", [&] { return io::read_volume(path, options); });
 }
 
 CLI::Validator method_validator()

@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <new>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/topology.hpp"
@@ -122,5 +124,19 @@ void end_progress_line();
 
 /// Throws `error` again with "path: " in front of its message, unless the message names the path.
 [[noreturn]] void rethrow_naming(const Error& error, const std::string& path);
+
+/// Runs `step()`. An Error is thrown again naming `path` (rethrow_naming), and std::bad_alloc
+/// becomes Error{too_large} "path: out of memory while DOING": one line that says which file and
+/// which step ran out of memory, rather than a bare "out of memory".
+template <class Step> decltype(auto) named_step(const std::string& path, const std::string& doing, Step&& step)
+{
+    try {
+        return step();
+    } catch (const Error& e) {
+        rethrow_naming(e, path);
+    } catch (const std::bad_alloc&) {
+        throw Error(Status::too_large, path + ": out of memory while " + doing);
+    }
+}
 
 } // namespace cmc33::cli

@@ -2,12 +2,16 @@
 // once, in parallel; with 4 KiB pages most of that time goes to page faults. Blocks of 4 MiB and
 // more are aligned to 2 MiB and advised for transparent huge pages (Linux, when THP is in
 // "madvise" or "always" mode; elsewhere the advice is ignored and they are plain pages).
+// A failed allocation says how many bytes it wanted: a mesh too large for memory (or for
+// `ulimit -v`) is reported as such, and the command line names the file it came from.
 
 #include <sys/mman.h>
 
 #include <cstdlib>
 #include <new>
+#include <string>
 
+#include "cmc33/error.hpp"
 #include "cmc33/mesh.hpp"
 
 namespace cmc33::detail {
@@ -15,13 +19,22 @@ namespace cmc33::detail {
 namespace {
 constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kLarge = 2 * kHugePage;
+
+[[noreturn]] void out_of_memory(std::size_t bytes)
+{
+    throw Error(Status::too_large, "cannot allocate " + std::to_string(bytes) + " bytes for the mesh (out of memory)");
+}
 } // namespace
 
 void* allocate_buffer(std::size_t bytes)
 {
-    if (bytes < kLarge) return ::operator new(bytes);
+    if (bytes < kLarge) {
+        void* small = ::operator new(bytes, std::nothrow);
+        if (small == nullptr) out_of_memory(bytes);
+        return small;
+    }
     void* p = nullptr;
-    if (posix_memalign(&p, kHugePage, bytes) != 0) throw std::bad_alloc();
+    if (posix_memalign(&p, kHugePage, bytes) != 0) out_of_memory(bytes);
 #ifdef MADV_HUGEPAGE
     (void)madvise(p, bytes & ~(kHugePage - 1), MADV_HUGEPAGE); // advice only: failure is harmless
 #endif

@@ -542,9 +542,11 @@ template <class T> void validate(const GridView<T>& g, double iso)
         }
     }
     if (g.strides[0] != 1) throw Error(Status::invalid_argument, "grid view must have unit x-stride");
-    if (g.nx() > std::numeric_limits<std::int32_t>::max()) {
-        throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) +
-                                           " samples along x; the extractor handles at most 2^31 - 1 per row");
+    // a row's crossed-edge count (up to 3 nx) is summed in 32 bits, which keeps that loop vectorised
+    constexpr std::int64_t kMaxRow = std::numeric_limits<std::uint32_t>::max() / 3;
+    if (g.nx() > kMaxRow) {
+        throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) + " samples along x; the extractor handles at most " +
+                                           std::to_string(kMaxRow) + " per row");
     }
     if constexpr (std::is_floating_point_v<T>) {
         std::int64_t count = 0;
