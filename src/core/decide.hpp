@@ -105,11 +105,16 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
 }
 
 /// The face saddle's value minus iso, for reports (rounded; the decision does not use it).
-inline double face_saddle(const double* v, int f)
+/// Computed in long double from the samples: with values near +-1e308, A C and A + C pass the
+/// double range (x86-64 and AArch64 long doubles reach 1e4932), while the saddle, which lies
+/// between the face's values, fits a double again. Where long double is double, such values give
+/// inf or NaN here (callers print them as out of range) and the decision stays exact.
+inline double face_saddle(const double* raw, double iso, int f)
 {
     const auto p = face_cycle(f);
-    const double A = v[p[0]], B = v[p[1]], C = v[p[2]], D = v[p[3]];
-    return (A * C - B * D) / (A + C - B - D);
+    const long double A = static_cast<long double>(raw[p[0]]) - iso, B = static_cast<long double>(raw[p[1]]) - iso,
+                      C = static_cast<long double>(raw[p[2]]) - iso, D = static_cast<long double>(raw[p[3]]) - iso;
+    return static_cast<double>((A * C - B * D) / (A + C - B - D));
 }
 
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
@@ -306,7 +311,7 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
         for (int f = 0; f < 6; ++f) {
             if (!((amb >> f) & 1u)) continue;
             if (face_joined<R>(w, v[face_cycle(f)[0]] >= 0, f)) bits |= 1u << i;
-            if (report) report->faces[f] = {true, face_saddle(v, f), ((bits >> i) & 1u) != 0, true};
+            if (report) report->faces[f] = {true, face_saddle(raw, iso, f), ((bits >> i) & 1u) != 0, true};
             ++i;
         }
     } else if (report) {
