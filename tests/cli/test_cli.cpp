@@ -953,6 +953,11 @@ TEST(CliExtreme, DoublesSpanningTheWholeRange)
     ASSERT_EQ(cell.code, 0) << cell.err;
     EXPECT_EQ(cell.out.find("nan"), std::string::npos) << cell.out;
     EXPECT_NE(cell.out.find("ambiguous, saddle 0,"), std::string::npos) << cell.out;
+    // and the interior test's numbers (case 13 at 1e308): roots and t_max, no NaN
+    const Result tunnel = run("cell -0.5e308 0.2e308 0.3e308 -0.4e308 0.6e308 -0.1e308 -0.7e308 0.8e308");
+    ASSERT_EQ(tunnel.code, 0) << tunnel.err;
+    EXPECT_EQ(tunnel.out.find("nan"), std::string::npos) << tunnel.out;
+    EXPECT_NE(tunnel.out.find("t_max = -b/2a = 0.3676471"), std::string::npos) << tunnel.out;
 }
 
 TEST(CliExtreme, CoordinatesBeyondFloatAreRefusedNamingTheFile)
