@@ -174,7 +174,8 @@ void print_cell(const CellArgs& args, Method method, const CellReport& r, const 
         } else if (!face.used) {
             std::cout << "ambiguous, not used (method " << method_name(method) << ")\n";
         } else {
-            std::cout << "ambiguous, saddle " << g7(face.saddle) << ", "
+            std::cout << "ambiguous, saddle "
+                      << (std::isfinite(face.saddle) ? g7(face.saddle) : "beyond the double range") << ", "
                       << (face.joined ? "joined" : "separated") << '\n';
         }
     }

@@ -33,18 +33,31 @@ struct Histogram {
     std::vector<double> fine_min = std::vector<double>(kFineBins, 0); ///< smallest sample in each fine bin
     std::int64_t finite = 0;
 
-    double width() const { return (hi - lo) / kBins; }
-    double fine_width() const { return (hi - lo) / kFineBins; }
+    /// The value at x / n of the way from lo to hi. When hi - lo passes the double range
+    /// (samples near +-1e308) it is weighted from both ends instead, which cannot overflow.
+    double at(double x, int n) const
+    {
+        if (std::isfinite(hi - lo)) return lo + x * ((hi - lo) / n);
+        const double f = x / n;
+        return lo * (1 - f) + hi * f;
+    }
+    /// Where v lies between lo and hi, in [0, 1] (0 when they are equal).
+    double fraction(double v) const
+    {
+        const double range = hi - lo;
+        if (!(range > 0)) return 0.0;
+        const double u = std::isfinite(range) ? (v - lo) / range : (0.5 * v - 0.5 * lo) / (0.5 * hi - 0.5 * lo);
+        return u >= 0 ? std::min(u, 1.0) : 0.0; // NaN would become a bin index
+    }
 };
 
 template <class T> void fill(const GridView<T>& grid, std::int64_t count, Histogram& h)
 {
-    const double range = h.hi - h.lo;
     for (std::int64_t i = 0; i < count; ++i) {
         const double v = static_cast<double>(grid.data[i]);
         if (!std::isfinite(v)) continue;
         ++h.finite;
-        const double u = range > 0 ? (v - h.lo) / range : 0.0; // in [0, 1]
+        const double u = h.fraction(v);
         h.bins[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(u * kBins)))]++;
         const auto f = static_cast<std::size_t>(std::min(kFineBins - 1, static_cast<int>(u * kFineBins)));
         if (h.fine[f]++ == 0 || v < h.fine_min[f]) h.fine_min[f] = v;
@@ -85,7 +98,7 @@ double otsu(const Histogram& h)
         const double between = w0 * w1 * (m0 - m1) * (m0 - m1);
         if (between > best) best = between, best_b = b;
     }
-    return h.lo + (best_b + 1) * h.fine_width(); // the upper edge of the lower class
+    return h.at(best_b + 1, kFineBins); // the upper edge of the lower class
 }
 
 /// Centres of the histogram's local maxima, the most populated first.
@@ -108,7 +121,9 @@ std::vector<int> modes(const Histogram& h)
 double round_for(double value, ScalarType type)
 {
     if (type != ScalarType::f32 && type != ScalarType::f64) return std::round(value);
-    return std::stod(sig(value, 4));
+    // 4 digits can round past the largest double (1.797693e308 -> 1.798e308): keep the value then
+    const double rounded = std::strtod(sig(value, 4).c_str(), nullptr);
+    return std::isfinite(rounded) ? rounded : value;
 }
 
 struct Candidate {
@@ -124,10 +139,10 @@ std::vector<Candidate> candidates(const Histogram& h, ScalarType type)
     std::vector<int> peaks = modes(h);
     if (peaks.size() > 3) peaks.resize(3);
     std::sort(peaks.begin(), peaks.end());
-    auto centre = [&](int b) { return h.lo + (b + 0.5) * h.width(); };
+    auto centre = [&](int b) { return h.at(b + 0.5, kBins); };
     for (std::size_t i = 0; i + 1 < peaks.size(); ++i) {
         const double a = centre(peaks[i]), b = centre(peaks[i + 1]);
-        out.push_back({round_for(0.5 * (a + b), type),
+        out.push_back({round_for(0.5 * a + 0.5 * b, type),
                        "midway between the histogram modes near " + sig(a, 4) + " and " + sig(b, 4)});
     }
     return out;
@@ -140,6 +155,18 @@ std::string bar(std::int64_t n, std::int64_t largest)
     // log scale: volumes are mostly background, a linear bar would show only the background bin
     const double f = std::log1p(static_cast<double>(n)) / std::log1p(static_cast<double>(largest));
     return std::string(static_cast<std::size_t>(std::max(1.0, std::round(f * kWidth))), '#');
+}
+
+/// The frame beyond spacing and origin: the named space, and the direction of each axis when
+/// they are not x, y, z themselves (docs/conventions.md).
+void print_frame(const Volume& volume)
+{
+    if (!volume.space().empty()) std::cout << "space " << volume.space() << '\n';
+    const Mat3& d = volume.direction();
+    if (d == kIdentity3) return;
+    std::cout << "directions (world direction of +i, +j, +k):";
+    for (std::size_t a = 0; a < 3; ++a) std::cout << " " << "ijk"[a] << " " << vec_text({d[0][a], d[1][a], d[2][a]});
+    std::cout << (determinant(d) < 0 ? "; mirrored (det < 0): extract reverses the triangles' winding" : "") << '\n';
 }
 
 void run_info(const InfoArgs& args)
@@ -163,8 +190,8 @@ void run_info(const InfoArgs& args)
                              {"first", bad.count > 0 ? Json{bad.first[0], bad.first[1], bad.first[2]} : Json(nullptr)}};
         Json bins = Json::array();
         for (int b = 0; b < kBins && has_values; ++b) {
-            bins.push_back({{"lo", lo + b * h.width()},
-                            {"hi", b + 1 == kBins ? hi : lo + (b + 1) * h.width()},
+            bins.push_back({{"lo", h.at(b, kBins)},
+                            {"hi", b + 1 == kBins ? hi : h.at(b + 1, kBins)},
                             {"count", h.bins[static_cast<std::size_t>(b)]}});
         }
         out["histogram"] = bins;
@@ -180,6 +207,7 @@ void run_info(const InfoArgs& args)
     std::cout << args.input << ": " << dims_text(volume.dims()) << " " << type_name(volume.type()) << " ("
               << volume.sample_count() << " samples, " << volume.byte_size() << " bytes)\n";
     std::cout << "spacing " << vec_text(volume.spacing()) << ", origin " << vec_text(volume.origin()) << '\n';
+    print_frame(volume);
     if (!has_values) {
         std::cout << "no finite samples\n";
     } else {
@@ -193,7 +221,7 @@ void run_info(const InfoArgs& args)
     std::cout << "histogram (" << kBins << " bins, bar length on a log scale):\n";
     const std::int64_t largest = *std::max_element(h.bins.begin(), h.bins.end());
     for (int b = 0; b < kBins; ++b) {
-        const double a = lo + b * h.width(), z = b + 1 == kBins ? hi : lo + (b + 1) * h.width();
+        const double a = h.at(b, kBins), z = b + 1 == kBins ? hi : h.at(b + 1, kBins);
         char line[160];
         std::snprintf(line, sizeof line, "  [%11.5g, %11.5g%c %12lld  ", a, z, b + 1 == kBins ? ']' : ')',
                       static_cast<long long>(h.bins[static_cast<std::size_t>(b)]));
@@ -224,7 +252,8 @@ void add_info(CLI::App& app)
     cmd->add_flag("--json", args->json, "Print one JSON object");
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
-        "Reads INPUT and prints its dimensions, sample type, spacing and origin, the range of its\n"
+        "Reads INPUT and prints its dimensions, sample type, spacing and origin (and the axis\n"
+        "directions and named space when the file gives them), the range of its\n"
         "values, how many samples are NaN or infinite (extract refuses those), a 16-bin histogram\n"
         "and some quantiles, then a hint with isovalues worth trying: Otsu's threshold (the value\n"
         "that best splits the samples in two classes, e.g. object and air) and the midpoints\n"

@@ -256,11 +256,17 @@ Json volume_json(const std::string& path, const Volume& volume)
     const Index3& d = volume.dims();
     const Vec3& s = volume.spacing();
     const Vec3& o = volume.origin();
+    const Mat3& m = volume.direction();
+    Json direction = Json::array(); // row by row: column a is the world direction of axis a
+    for (const Vec3& row : m) direction.push_back({json_number(row[0]), json_number(row[1]), json_number(row[2])});
     return Json{{"file", path},
                 {"dims", {d[0], d[1], d[2]}},
                 {"type", std::string(type_name(volume.type()))},
                 {"spacing", {json_number(s[0]), json_number(s[1]), json_number(s[2])}},
-                {"origin", {json_number(o[0]), json_number(o[1]), json_number(o[2])}}};
+                {"origin", {json_number(o[0]), json_number(o[1]), json_number(o[2])}},
+                {"direction", direction},
+                {"mirrored", determinant(m) < 0},
+                {"space", volume.space().empty() ? Json(nullptr) : Json(volume.space())}};
 }
 
 Json topology_json(const MeshTopology& t)

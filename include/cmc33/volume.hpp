@@ -2,12 +2,19 @@
 /// @file volume.hpp
 /// Volumes: `Volume` owns typed samples; `GridView<T>` is the non-owning view the extractor and
 /// the verifier read. Samples are stored x fastest, then y, then z (C order [z][y][x]), in the
-/// machine's byte order. World position of sample (i, j, k) = origin + spacing * (i, j, k).
+/// machine's byte order.
+///
+/// The frame: world position of sample (i, j, k) = origin + D * (spacing (.) (i, j, k)), where
+/// D (`direction`) is a 3x3 matrix whose column a is the world direction of +axis a (unit length;
+/// flips, permutations and oblique frames alike) and spacing (> 0) the distance between samples
+/// along each axis. M = D * diag(spacing) is the index-to-world matrix (frame_matrix()). D is the
+/// identity by default, so the older form origin + spacing * (i, j, k) is the default frame.
 
 #include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
@@ -35,6 +42,30 @@ template <> constexpr ScalarType scalar_type_of<double>() { return ScalarType::f
 
 using Index3 = std::array<std::int64_t, 3>;
 using Vec3 = std::array<double, 3>;
+/// Row-major: m[r][c] is row r, column c.
+using Mat3 = std::array<Vec3, 3>;
+
+inline constexpr Mat3 kIdentity3{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+
+/// M = D * diag(spacing): column a of M is the world step from sample index a to a + 1.
+inline Mat3 frame_matrix(const Vec3& spacing, const Mat3& direction) noexcept
+{
+    Mat3 m{};
+    for (std::size_t r = 0; r < 3; ++r)
+        for (std::size_t c = 0; c < 3; ++c) m[r][c] = direction[r][c] * spacing[c];
+    return m;
+}
+/// Determinant of a 3x3 matrix.
+inline double determinant(const Mat3& m) noexcept
+{
+    return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+           m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+/// True when only the diagonal is non-zero (an axis-aligned frame, possibly with flips).
+inline bool is_diagonal(const Mat3& m) noexcept
+{
+    return m[0][1] == 0 && m[0][2] == 0 && m[1][0] == 0 && m[1][2] == 0 && m[2][0] == 0 && m[2][1] == 0;
+}
 
 /// Non-owning view of samples of type T. Unit x-stride is required; y and z strides are in
 /// elements, so a view can cover a sub-block of a larger array without copying.
@@ -44,11 +75,13 @@ template <class T> struct GridView {
     Index3 strides{1, 0, 0}; ///< element strides; strides[0] must be 1
     Vec3 spacing{1, 1, 1};
     Vec3 origin{0, 0, 0};
+    Mat3 direction = kIdentity3; ///< column a: world direction of +axis a (see the file comment)
 
     /// A dense view: strides {1, nx, nx*ny}.
-    static GridView dense(const T* data, Index3 dims, Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0})
+    static GridView dense(const T* data, Index3 dims, Vec3 spacing = {1, 1, 1}, Vec3 origin = {0, 0, 0},
+                          const Mat3& direction = kIdentity3)
     {
-        return GridView{data, dims, {1, dims[0], dims[0] * dims[1]}, spacing, origin};
+        return GridView{data, dims, {1, dims[0], dims[0] * dims[1]}, spacing, origin, direction};
     }
     std::int64_t nx() const noexcept { return dims[0]; }
     std::int64_t ny() const noexcept { return dims[1]; }
@@ -75,8 +108,15 @@ public:
     const Index3& dims() const noexcept { return dims_; }
     const Vec3& spacing() const noexcept { return spacing_; }
     const Vec3& origin() const noexcept { return origin_; }
+    /// Column a: world direction of +axis a, unit length (identity unless the file gave a frame).
+    const Mat3& direction() const noexcept { return direction_; }
+    /// The named space of the world coordinates as the file gave it ("left-posterior-superior",
+    /// MetaImage "RAI", ...); empty when the file named none. Recorded, not interpreted.
+    const std::string& space() const noexcept { return space_; }
     void set_spacing(const Vec3& s) noexcept { spacing_ = s; }
     void set_origin(const Vec3& o) noexcept { origin_ = o; }
+    void set_direction(const Mat3& d) noexcept { direction_ = d; }
+    void set_space(std::string name) { space_ = std::move(name); }
     std::int64_t sample_count() const noexcept { return dims_[0] * dims_[1] * dims_[2]; }
     std::size_t byte_size() const noexcept { return static_cast<std::size_t>(sample_count()) * type_size(type_); }
     std::byte* bytes() noexcept { return data_.get(); }
@@ -95,7 +135,7 @@ public:
     }
     template <class T> GridView<T> view() const
     {
-        return GridView<T>::dense(samples<T>(), dims_, spacing_, origin_);
+        return GridView<T>::dense(samples<T>(), dims_, spacing_, origin_, direction_);
     }
 
     /// Calls f(GridView<T>) with T the stored sample type; returns what f returns.
@@ -107,6 +147,8 @@ private:
     Index3 dims_{0, 0, 0};
     Vec3 spacing_{1, 1, 1};
     Vec3 origin_{0, 0, 0};
+    Mat3 direction_ = kIdentity3;
+    std::string space_;
     std::unique_ptr<std::byte[]> data_;
 };
 

@@ -105,11 +105,16 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
 }
 
 /// The face saddle's value minus iso, for reports (rounded; the decision does not use it).
-inline double face_saddle(const double* v, int f)
+/// Computed in long double from the samples: with values near +-1e308, A C and A + C pass the
+/// double range (x86-64 and AArch64 long doubles reach 1e4932), while the saddle, which lies
+/// between the face's values, fits a double again. Where long double is double, such values give
+/// inf or NaN here (callers print them as out of range) and the decision stays exact.
+inline double face_saddle(const double* raw, double iso, int f)
 {
     const auto p = face_cycle(f);
-    const double A = v[p[0]], B = v[p[1]], C = v[p[2]], D = v[p[3]];
-    return (A * C - B * D) / (A + C - B - D);
+    const long double A = static_cast<long double>(raw[p[0]]) - iso, B = static_cast<long double>(raw[p[1]]) - iso,
+                      C = static_cast<long double>(raw[p[2]]) - iso, D = static_cast<long double>(raw[p[3]]) - iso;
+    return static_cast<double>((A * C - B * D) / (A + C - B - D));
 }
 
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
@@ -255,33 +260,43 @@ inline double t_alt(const double* v, int edge)
     return t;
 }
 
-/// The numbers `cmc33 cell` shows (plain values, without the eps of the decisions).
-inline void report_numbers(const Sweep& s, const Sweep& lewiner, double t_lewiner, const Variant& var, InteriorReport& r)
+/// The numbers `cmc33 cell` shows (plain values, without the eps of the decisions), computed in
+/// long double from the samples so that values near +-1e308 give finite roots and saddles (and
+/// inf, not NaN, for a, b, c and F where those pass the double range; see face_saddle).
+inline void report_numbers(const double* raw, double iso, double t_lewiner, const Variant& var, InteriorReport& r)
 {
+    using L = long double;
+    L vl[8];
+    for (int q = 0; q < 8; ++q) vl[q] = static_cast<L>(raw[q]) - iso;
+    const SweepT<L> s(vl, var.axis, var.corner), lewiner(vl, var.lewiner_axis, var.lewiner_corner);
     r.tested = true;
     r.test = var.test == kTestTunnel ? "tunnel" : "13.5";
     r.axis = var.axis, r.corner_a = var.corner, r.corner_c = var.corner ^ 7;
     r.lewiner_axis = var.lewiner_axis, r.lewiner_corner = var.lewiner_corner, r.lewiner_edge = var.lewiner_edge;
-    r.a = s.a(), r.b = s.b(), r.c = s.c();
-    r.t_max = r.a != 0 ? -r.b / (2 * r.a) : kNaN;
-    r.f_t_max = r.a != 0 ? s.F(r.t_max) : kNaN;
+    const L a = s.a(), b = s.b(), c = s.c();
+    r.a = static_cast<double>(a), r.b = static_cast<double>(b), r.c = static_cast<double>(c);
+    const L t_max = a != 0 ? -b / (2 * a) : L(kNaN);
+    r.t_max = static_cast<double>(t_max);
+    r.f_t_max = a != 0 ? static_cast<double>(s.F(t_max)) : kNaN;
     r.t_alt = t_lewiner;
-    r.f_t_alt = lewiner.F(t_lewiner);
+    r.f_t_alt = static_cast<double>(lewiner.F(t_lewiner));
     r.t1 = r.t2 = kNaN;
-    const double disc = r.b * r.b - 4 * r.a * r.c;
-    if (r.a != 0 && disc >= 0) {
-        const double q = -0.5 * (r.b + std::copysign(std::sqrt(disc), r.b)); // stable roots
-        double t1 = q / r.a, t2 = q != 0 ? r.c / q : t1;
+    L t1 = kNaN, t2 = kNaN;
+    const L disc = b * b - 4 * a * c;
+    if (a != 0 && disc >= 0) {
+        const L q = -0.5L * (b + std::copysign(std::sqrt(disc), b)); // stable roots
+        t1 = q / a, t2 = q != 0 ? c / q : t1;
         if (t1 > t2) std::swap(t1, t2);
-        r.t1 = t1, r.t2 = t2;
+        r.t1 = static_cast<double>(t1), r.t2 = static_cast<double>(t2);
     }
-    const auto saddle = [&](double t) -> std::array<double, 2> {
+    const auto saddle = [&](L t) -> std::array<double, 2> {
         if (std::isnan(t)) return {kNaN, kNaN};
-        const double a_t = Sweep::at(s.A0, s.A1, t), b_t = Sweep::at(s.B0, s.B1, t), d_t = Sweep::at(s.D0, s.D1, t);
-        const double den = s.den(t);
-        return {(a_t - d_t) / den, (a_t - b_t) / den};
+        const L a_t = SweepT<L>::at(s.A0, s.A1, t), b_t = SweepT<L>::at(s.B0, s.B1, t),
+                d_t = SweepT<L>::at(s.D0, s.D1, t);
+        const L den = s.den(t);
+        return {static_cast<double>((a_t - d_t) / den), static_cast<double>((a_t - b_t) / den)};
     };
-    r.saddle1 = saddle(r.t1), r.saddle2 = saddle(r.t2);
+    r.saddle1 = saddle(t1), r.saddle2 = saddle(t2);
 }
 
 struct Decision {
@@ -306,7 +321,7 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
         for (int f = 0; f < 6; ++f) {
             if (!((amb >> f) & 1u)) continue;
             if (face_joined<R>(w, v[face_cycle(f)[0]] >= 0, f)) bits |= 1u << i;
-            if (report) report->faces[f] = {true, face_saddle(v, f), ((bits >> i) & 1u) != 0, true};
+            if (report) report->faces[f] = {true, face_saddle(raw, iso, f), ((bits >> i) & 1u) != 0, true};
             ++i;
         }
     } else if (report) {
@@ -324,7 +339,7 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
     const SweepT<E> sweep(ve, var->axis, var->corner);
     const Sweep lewiner(v, var->lewiner_axis, var->lewiner_corner);
     const double t_lewiner = t_alt(v, var->lewiner_edge);
-    if (r) report_numbers(Sweep(v, var->axis, var->corner), lewiner, t_lewiner, *var, *r);
+    if (r) report_numbers(raw, iso, t_lewiner, *var, *r);
     const int base = kBaseCase[config];
     bool tunnel = false;
     int tiling = 1;

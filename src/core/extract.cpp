@@ -10,10 +10,17 @@
 //      decided again rather than stored: working memory is O(rows + threads * nx), not O(cells).
 // Rows are processed in parallel by z-slab; all writes land at offsets fixed by pass 2, so the mesh
 // is the same, byte for byte, for every thread count.
+//
+// World coordinates (volume.hpp): x = origin + M * (i, j, k) with M = D * diag(spacing). A diagonal
+// M (the usual axis-aligned frame, flips included) takes the per-axis multiply of old; only an
+// oblique or permuted frame pays for the full product. Normals map the index-space gradient by
+// M^-T; a mirroring frame (det M < 0) reverses every triangle so that the winding rule of
+// docs/conventions.md holds in world space.
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -153,12 +160,32 @@ inline unsigned crossed_edges(const std::uint8_t* f, const std::uint8_t* fy, con
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 
+/// The largest |world coordinate| over the 8 corners of the grid's box (every vertex lies in it).
+template <class T> double largest_coordinate(const GridView<T>& g)
+{
+    const Mat3 m = frame_matrix(g.spacing, g.direction);
+    double largest = 0;
+    for (int corner = 0; corner < 8; ++corner) {
+        double x[3];
+        for (std::size_t a = 0; a < 3; ++a) x[a] = (corner >> a) & 1 ? static_cast<double>(g.dims[a] - 1) : 0.0;
+        for (std::size_t r = 0; r < 3; ++r) {
+            const double w = g.origin[r] + (m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2]);
+            largest = std::max(largest, std::fabs(w));
+        }
+    }
+    return largest;
+}
+
 template <class T> class Extractor {
 public:
-    Extractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
+    Extractor(const GridView<T>& g, double iso, const ExtractOptions& opt, double largest_sample)
         : g_(g), iso_(iso), above_(iso), opt_(opt), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()),
-          threads_(detail::resolve_threads(opt.threads)), delta_(min_crossing(g))
+          threads_(detail::resolve_threads(opt.threads)), m_(frame_matrix(g.spacing, g.direction)),
+          diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0), delta_(min_crossing(g, m_))
     {
+        for (std::size_t a = 0; a < 3; ++a) step_[a] = diagonal_ ? m_[a][a] : 1.0;
+        if (!diagonal_) normal_map_ = inverse_transpose(m_);
+        gradient_scale_ = gradient_scale(largest_sample);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
             needs_values_[code] = opt.method != Method::mc &&
@@ -370,25 +397,77 @@ private:
     double crossing(T a, T b) const
     {
         const double va = static_cast<double>(a), vb = static_cast<double>(b);
-        return detail::clamp_crossing((iso_ - va) / (vb - va), delta_); // ends differ in sign: vb != va
+        const double d = vb - va; // ends differ in sign: vb != va
+        if (std::isinf(d)) {
+            // |vb - va| passes DBL_MAX (samples near +-1e308): the same ratio on halved values,
+            // which cannot overflow; iso lies between va and vb, so |iso - va| <= |vb - va|
+            return detail::clamp_crossing((0.5 * iso_ - 0.5 * va) / (0.5 * vb - 0.5 * va), delta_);
+        }
+        return detail::clamp_crossing((iso_ - va) / d, delta_);
     }
 
     /// delta of placement.hpp for this grid: 2^-10 of an edge, or more where the output floats
     /// cannot tell a point delta along an edge from the sample (16 units in the last place of the
     /// largest coordinate, at most 1/8 of an edge).
-    static double min_crossing(const GridView<T>& g)
+    static double min_crossing(const GridView<T>& g, const Mat3& m)
     {
-        double largest = 0, shortest = std::numeric_limits<double>::infinity();
+        const double largest = largest_coordinate(g);
+        double shortest = std::numeric_limits<double>::infinity();
         for (std::size_t a = 0; a < 3; ++a) {
-            const double far = g.origin[a] + g.spacing[a] * static_cast<double>(g.dims[a] - 1);
-            largest = std::max({largest, std::fabs(g.origin[a]), std::fabs(far)});
-            shortest = std::min(shortest, std::fabs(g.spacing[a]));
+            const double length = is_diagonal(m) ? std::fabs(m[a][a]) : std::hypot(m[0][a], m[1][a], m[2][a]);
+            shortest = std::min(shortest, length);
         }
         if (!(largest > 0) || !(shortest > 0) || !std::isfinite(largest)) return detail::kMinCrossing;
         const double ulp = std::ldexp(1.0, std::ilogb(largest) - 23);
         return std::clamp(16 * ulp / shortest, detail::kMinCrossing, 0.125);
     }
 
+    /// The world position of index-space point x (the frame of volume.hpp), rounded to float.
+    void write_position(const double x[3], float* out) const
+    {
+        if (diagonal_) {
+            for (std::size_t c = 0; c < 3; ++c) out[c] = static_cast<float>(g_.origin[c] + step_[c] * x[c]);
+            return;
+        }
+        for (std::size_t c = 0; c < 3; ++c)
+            out[c] = static_cast<float>(g_.origin[c] + (m_[c][0] * x[0] + m_[c][1] * x[1] + m_[c][2] * x[2]));
+    }
+
+    static Mat3 inverse_transpose(const Mat3& m)
+    {
+        // the cofactor matrix over the determinant: (M^-1)^T = cof(M) / det M
+        const double det = determinant(m);
+        Mat3 r{};
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = 0; j < 3; ++j) {
+                const std::size_t i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+                r[i][j] = (m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]) / det;
+            }
+        return r;
+    }
+
+    /// A power of two that keeps every scaled gradient, and its interpolation between two samples,
+    /// finite: 1 unless the samples or the map to world gradients are near the double range.
+    double gradient_scale(double largest_sample) const
+    {
+        double map = 0; // largest factor from an index difference to a world gradient component
+        for (std::size_t r = 0; r < 3; ++r) {
+            if (diagonal_) {
+                map = std::max(map, 1 / std::fabs(step_[r]));
+            } else {
+                map = std::max(map, std::fabs(normal_map_[r][0]) + std::fabs(normal_map_[r][1]) +
+                                        std::fabs(normal_map_[r][2]));
+            }
+        }
+        if (!(largest_sample > 0) || !(map > 0) || !std::isfinite(map)) return 1;
+        // |gradient component| <= 2 * largest * map, its interpolation 3 times that: 2^3
+        const int exponent = std::ilogb(largest_sample) + std::ilogb(map) + 5;
+        return exponent > 1000 ? std::ldexp(1.0, 1000 - exponent) : 1.0;
+    }
+
+    /// The gradient at sample (i, j, k) by central differences (one-sided at the border), in world
+    /// coordinates for a diagonal frame, in index coordinates otherwise (write_normal maps it),
+    /// times gradient_scale_.
     std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k) const
     {
         std::array<double, 3> grad{};
@@ -398,9 +477,10 @@ private:
             std::int64_t lo[3] = {i, j, k}, hi[3] = {i, j, k};
             if (idx[axis] > 0) --lo[axis];
             if (idx[axis] + 1 < n[axis]) ++hi[axis];
-            const double d = static_cast<double>(hi[axis] - lo[axis]) * g_.spacing[static_cast<std::size_t>(axis)];
+            const double d = static_cast<double>(hi[axis] - lo[axis]) * step_[static_cast<std::size_t>(axis)];
+            const double s = gradient_scale_; // 1 unless differences of the samples could overflow
             grad[static_cast<std::size_t>(axis)] =
-                (static_cast<double>(at(hi[0], hi[1], hi[2])) - static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
+                (s * static_cast<double>(at(hi[0], hi[1], hi[2])) - s * static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
         }
         return grad;
     }
@@ -416,11 +496,9 @@ private:
             const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
             const double t = crossing(at(i, j, k), at(end[0], end[1], end[2]));
             const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
-            float* out = &mesh.positions[static_cast<std::size_t>(id) * 3];
-            for (int c = 0; c < 3; ++c) {
-                const double x = p[c] + (c == axis ? t : 0.0);
-                out[c] = static_cast<float>(g_.origin[static_cast<std::size_t>(c)] + g_.spacing[static_cast<std::size_t>(c)] * x);
-            }
+            double x[3];
+            for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
+            write_position(x, &mesh.positions[static_cast<std::size_t>(id) * 3]);
             if (opt_.normals) {
                 const auto ga = gradient(i, j, k), gb = gradient(end[0], end[1], end[2]);
                 write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3],
@@ -429,10 +507,23 @@ private:
         }
     }
 
-    /// Normals point from above to below: along minus the gradient.
-    static void write_normal(float* out, std::array<double, 3> g)
+    /// Normals point from above to below: along minus the world gradient.
+    void write_normal(float* out, std::array<double, 3> g) const
     {
-        const double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (!diagonal_) {
+            const Mat3& n = normal_map_;
+            g = {n[0][0] * g[0] + n[0][1] * g[1] + n[0][2] * g[2], n[1][0] * g[0] + n[1][1] * g[1] + n[1][2] * g[2],
+                 n[2][0] * g[0] + n[2][1] * g[1] + n[2][2] * g[2]};
+        }
+        double len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (!(len > 0) || !std::isfinite(len)) {
+            // the squares overflow (or underflow): divide by the largest component first
+            const double big = std::max({std::fabs(g[0]), std::fabs(g[1]), std::fabs(g[2])});
+            if (big > 0 && std::isfinite(big)) {
+                for (double& c : g) c /= big;
+                len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+            }
+        }
         for (int c = 0; c < 3; ++c) out[c] = len > 0 ? static_cast<float>(-g[static_cast<std::size_t>(c)] / len) : 0.0f;
     }
 
@@ -467,6 +558,9 @@ private:
                 const int v = codes[q];
                 out[q] = v < 12 ? edge_id[v] : static_cast<std::uint32_t>(first_interior + (v - 12));
             }
+            if (mirrored_) {
+                for (int q = 0; q < 3 * tl.triangle_count; q += 3) std::swap(out[q + 1], out[q + 2]);
+            }
             tri += tl.triangle_count;
         }
     }
@@ -499,11 +593,8 @@ private:
             double p[3];
             detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
             const auto id = static_cast<std::size_t>(first + q);
-            float* out = &mesh.positions[id * 3];
-            for (int c = 0; c < 3; ++c) {
-                const std::size_t cc = static_cast<std::size_t>(c);
-                out[c] = static_cast<float>(g_.origin[cc] + g_.spacing[cc] * (base[c] + p[c]));
-            }
+            const double x[3] = {base[0] + p[0], base[1] + p[1], base[2] + p[2]};
+            write_position(x, &mesh.positions[id * 3]);
             if (opt_.normals) {
                 double w[8];
                 detail::trilinear_weights(p, w);
@@ -521,6 +612,11 @@ private:
     ExtractOptions opt_;
     std::int64_t nx_, ny_, nz_;
     int threads_;
+    Mat3 m_;                  ///< index to world: M = D * diag(spacing)
+    bool diagonal_, mirrored_; ///< M diagonal; det M < 0 (triangles are reversed)
+    double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
+    Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
+    double gradient_scale_ = 1;
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
     std::array<bool, 256> needs_values_{};
     std::vector<std::int64_t> row_vertices_, row_triangles_;
@@ -529,7 +625,8 @@ private:
     std::vector<std::array<std::int32_t, 2>> range_;
 };
 
-template <class T> void validate(const GridView<T>& g, double iso)
+/// Checks the grid and isovalue; returns the largest |sample| (a bound for integer types).
+template <class T> double validate(const GridView<T>& g, double iso)
 {
     if (!std::isfinite(iso)) {
         throw Error(Status::non_finite, "isovalue " + std::to_string(iso) + " is not a finite number");
@@ -542,33 +639,60 @@ template <class T> void validate(const GridView<T>& g, double iso)
         }
     }
     if (g.strides[0] != 1) throw Error(Status::invalid_argument, "grid view must have unit x-stride");
+    const Mat3 m = frame_matrix(g.spacing, g.direction);
+    for (std::size_t r = 0; r < 3; ++r) {
+        const bool finite = std::isfinite(g.origin[r]) && std::isfinite(m[r][0]) && std::isfinite(m[r][1]) &&
+                            std::isfinite(m[r][2]);
+        if (!finite) throw Error(Status::non_finite, "the grid's origin, spacing or direction is not finite");
+    }
+    if (!(std::fabs(determinant(m)) > 0)) {
+        throw Error(Status::invalid_argument,
+                    "the grid's frame is degenerate (det of direction * spacing is 0); expected three "
+                    "independent axes");
+    }
+    const double largest = largest_coordinate(g);
+    if (!std::isfinite(static_cast<float>(largest))) {
+        char text[200];
+        std::snprintf(text, sizeof text, "world coordinates up to %.4g do not fit the output's 32-bit floats "
+                                         "(at most %.4g); scale the spacing or origin down", largest,
+                      static_cast<double>(std::numeric_limits<float>::max()));
+        throw Error(Status::too_large, text);
+    }
     // a row's crossed-edge count (up to 3 nx) is summed in 32 bits, which keeps that loop vectorised
     constexpr std::int64_t kMaxRow = std::numeric_limits<std::uint32_t>::max() / 3;
     if (g.nx() > kMaxRow) {
         throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) + " samples along x; the extractor handles at most " +
                                            std::to_string(kMaxRow) + " per row");
     }
+    double largest_sample = 0;
     if constexpr (std::is_floating_point_v<T>) {
         std::int64_t count = 0;
         Index3 first{-1, -1, -1};
         for (std::int64_t k = 0; k < g.nz(); ++k)
             for (std::int64_t j = 0; j < g.ny(); ++j)
-                for (std::int64_t i = 0; i < g.nx(); ++i)
-                    if (!std::isfinite(g(i, j, k)) && count++ == 0) first = {i, j, k};
+                for (std::int64_t i = 0; i < g.nx(); ++i) {
+                    const double v = std::fabs(static_cast<double>(g(i, j, k)));
+                    if (!std::isfinite(v) && count++ == 0) first = {i, j, k};
+                    largest_sample = std::max(largest_sample, v);
+                }
         if (count > 0) {
             throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
                                                 std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
                                                 std::to_string(first[2]) + "); cmc33 needs finite samples");
         }
+    } else {
+        largest_sample = std::max(std::fabs(static_cast<double>(std::numeric_limits<T>::lowest())),
+                                  static_cast<double>(std::numeric_limits<T>::max()));
     }
+    return largest_sample;
 }
 
 } // namespace
 
 template <class T> Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
 {
-    validate(grid, iso);
-    return Extractor<T>(grid, iso, options).run(stats);
+    const double largest_sample = validate(grid, iso);
+    return Extractor<T>(grid, iso, options, largest_sample).run(stats);
 }
 
 Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, ExtractStats* stats)

@@ -5,6 +5,7 @@
 //
 // HeaderSize (bytes to skip, -1: the samples are the last bytes) applies to a separate data file.
 
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <map>
@@ -97,7 +98,10 @@ ScalarType parse_element_type(const Field& field, const std::string& label)
                         field.line, "); expected MET_UCHAR, MET_SHORT, MET_FLOAT, ..."));
 }
 
-void check_identity(const Field& field, const std::string& label)
+/// TransformMatrix (or its synonyms Rotation, Orientation): 9 numbers, the world directions of
+/// the x, y and z axes one after the other, as ITK writes and reads them (its direction matrix
+/// column by column).
+std::array<Vec3, 3> parse_transform_matrix(const Field& field, const std::string& label)
 {
     const std::vector<std::string_view> words = split_words(field.value);
     if (words.size() != 9) {
@@ -105,6 +109,7 @@ void check_identity(const Field& field, const std::string& label)
                     str_cat(label, ": ", field_name(field), " has ", words.size(),
                             " values, expected 9 (a 3x3 matrix)"));
     }
+    std::array<Vec3, 3> axes{};
     for (std::size_t i = 0; i < 9; ++i) {
         double v = 0;
         if (!parse_real(words[i], v)) {
@@ -112,14 +117,13 @@ void check_identity(const Field& field, const std::string& label)
                                                     quote_bytes(words[i]), ' ',
                                                     real_problem(words[i])));
         }
-        const double expected = i % 4 == 0 ? 1.0 : 0.0;
-        if (!(std::fabs(v - expected) <= 1e-6)) {
-            throw Error(Status::unsupported_format,
-                        str_cat(label, ": ", field_name(field), " = ", quote_bytes(field.value, 80),
-                                " is not the identity (a rotated or flipped frame); cmc33 reads "
-                                "only axis-aligned volumes"));
+        if (!std::isfinite(v)) {
+            throw Error(Status::non_finite, str_cat(label, ": ", field_name(field), " value ",
+                                                    quote_bytes(words[i]), " is not finite"));
         }
+        axes[i / 3][i % 3] = v;
     }
+    return axes;
 }
 
 std::string met_type_name(ScalarType type)
@@ -216,8 +220,9 @@ Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
                     str_cat(label, ": BinaryData = False (line ", binary->line,
                             ", samples as text) is not supported"));
     }
+    const Field* matrix = nullptr;
     for (const char* key : {"transformmatrix", "rotation", "orientation"}) {
-        if (const Field* matrix = find(fields, key)) check_identity(*matrix, label);
+        if (matrix == nullptr) matrix = find(fields, key);
     }
 
     Grid grid;
@@ -235,6 +240,13 @@ Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
             break;
         }
     }
+    // CenterOfRotation does not move the samples (ITK ignores it for positions too).
+    if (matrix) {
+        set_frame(grid, parse_transform_matrix(*matrix, label), grid.spacing, label,
+                  field_name(*matrix));
+    }
+    if (const Field* orientation = find(fields, "anatomicalorientation"))
+        grid.space = normalize_blanks(orientation->value);
 
     Storage storage;
     storage.endian = Endian::little;
@@ -301,16 +313,24 @@ void write_metaimage(const Volume& volume, const std::filesystem::path& path, bo
     const Index3& n = volume.dims();
     const Vec3& s = volume.spacing();
     const Vec3& o = volume.origin();
+    const Mat3& d = volume.direction();
     std::string header = "ObjectType = Image\n"
                          "NDims = 3\n"
                          "BinaryData = True\n"
                          "BinaryDataByteOrderMSB = False\n"
-                         "CompressedData = False\n"
-                         "TransformMatrix = 1 0 0 0 1 0 0 0 1\n";
+                         "CompressedData = False\n";
+    header += "TransformMatrix =";
+    for (std::size_t a = 0; a < 3; ++a) // axis by axis, as parse_transform_matrix reads it
+        for (std::size_t r = 0; r < 3; ++r) header += " " + format_real(d[r][a]);
+    header += "\n";
     header +=
         "Offset = " + format_real(o[0]) + " " + format_real(o[1]) + " " + format_real(o[2]) + "\n";
     header += "ElementSpacing = " + format_real(s[0]) + " " + format_real(s[1]) + " " +
               format_real(s[2]) + "\n";
+    // only MetaImage's own three-letter codes ("RAI"), not a NRRD space name
+    const std::string& space = volume.space();
+    if (space.size() == 3 && space.find_first_not_of("RLAPSIrlapsi") == std::string::npos)
+        header += "AnatomicalOrientation = " + space + "\n";
     header += str_cat("DimSize = ", n[0], ' ', n[1], ' ', n[2], '\n');
     header += "ElementType = " + met_type_name(volume.type()) + "\n";
     if (local) {

@@ -66,7 +66,8 @@ constexpr std::string_view kUnsupportedTypes[] = {
     "uint64",   "uint64_t",  "block",
 };
 
-// Fields of the spec that say nothing cmc33 uses.
+// Fields of the spec that say nothing cmc33 uses ("space", "centers", "axis mins" and
+// "axis maxs" are read: kReadFields is looked up first).
 constexpr std::string_view kIgnoredFields[] = {
     "content",     "space",     "space dimension", "space units", "measurement frame",
     "kinds",       "centers",   "centerings",      "labels",      "units",
@@ -86,6 +87,13 @@ constexpr std::pair<std::string_view, std::string_view> kReadFields[] = {
     {"spacings", "spacings"},
     {"space directions", "space directions"},
     {"space origin", "space origin"},
+    {"space", "space"},
+    {"centers", "centers"},
+    {"centerings", "centers"},
+    {"axis mins", "axis mins"},
+    {"axismins", "axis mins"},
+    {"axis maxs", "axis maxs"},
+    {"axismaxs", "axis maxs"},
     {"byte skip", "byte skip"},
     {"byteskip", "byte skip"},
     {"line skip", "line skip"},
@@ -198,7 +206,8 @@ parse_vectors(const Field& field, std::string_view name, const std::string& labe
     return vectors;
 }
 
-Vec3 parse_space_directions(const Field& field, const std::string& label)
+/// The three axis vectors (world steps, any signs, permutations, oblique).
+std::array<Vec3, 3> parse_space_directions(const Field& field, const std::string& label)
 {
     const auto vectors = parse_vectors(field, "space directions", label);
     if (vectors.size() != 3) {
@@ -206,7 +215,7 @@ Vec3 parse_space_directions(const Field& field, const std::string& label)
                     str_cat(label, ": field \"space directions\" (line ", field.line, ") has ",
                             vectors.size(), " vectors, expected 3 (one per axis)"));
     }
-    Vec3 spacing{};
+    std::array<Vec3, 3> axes{};
     for (std::size_t axis = 0; axis < 3; ++axis) {
         if (!vectors[axis]) {
             throw Error(Status::unsupported_format,
@@ -220,36 +229,49 @@ Vec3 parse_space_directions(const Field& field, const std::string& label)
                                 " components (line ", field.line,
                                 "); cmc33 reads volumes in a 3D space"));
         }
-        const double norm = std::hypot(v[0], v[1], v[2]); // no underflow for tiny spacings
-        // Axis-aligned: the other two components vanish (up to rounding in the writer).
-        const bool aligned = norm > 0 && std::fabs(v[(axis + 1) % 3]) <= 1e-9 * norm &&
-                             std::fabs(v[(axis + 2) % 3]) <= 1e-9 * norm;
-        // One non-zero component elsewhere than on the diagonal: the axes are permuted, which
-        // is axis-aligned but not the sample order cmc33 reads.
-        std::size_t along = 3;
-        for (std::size_t c = 0; c < 3; ++c) {
-            const bool others_vanish = std::fabs(v[(c + 1) % 3]) <= 1e-9 * norm &&
-                                       std::fabs(v[(c + 2) % 3]) <= 1e-9 * norm;
-            if (norm > 0 && others_vanish) along = c;
-        }
-        if (!aligned && along != 3) {
-            throw Error(Status::unsupported_format,
-                        str_cat(label, ": space directions ", quote_bytes(field.value, 80),
-                                " (line ", field.line, ") permute the axes (sample axis ",
-                                axis + 1, " runs along space axis ", along + 1,
-                                "); cmc33 reads only diagonal directions like (sx,0,0) "
-                                "(0,sy,0) (0,0,sz)"));
-        }
-        if (!aligned) {
-            throw Error(Status::unsupported_format,
-                        str_cat(label, ": space directions ", quote_bytes(field.value, 80),
-                                " (line ", field.line,
-                                ") are not axis-aligned (a rotated or degenerate frame); cmc33 "
-                                "reads only diagonal directions like (sx,0,0) (0,sy,0) (0,0,sz)"));
-        }
-        spacing[axis] = norm;
+        axes[axis] = {v[0], v[1], v[2]};
     }
-    return spacing;
+    return axes;
+}
+
+/// "axis mins" (where each axis starts) as the position of the first sample: with "centers:
+/// cell" a sample sits in the middle of its cell, half a step (signed) after the axis's start.
+Vec3 parse_axis_mins(const Field& mins, const Field* centers, const Vec3& step,
+                     const std::string& label)
+{
+    Vec3 first = parse_vec3(split_words(mins.value), label,
+                            str_cat("field \"axis mins\" (line ", mins.line, ")"), false);
+    if (centers) {
+        const std::vector<std::string_view> words = split_words(centers->value);
+        if (words.size() != 3) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": field \"centers\" (line ", centers->line, ") ",
+                                quote_bytes(centers->value),
+                                " does not give 3 centerings (cell, node or \"???\" each)"));
+        }
+        for (std::size_t a = 0; a < 3; ++a)
+            if (lower_ascii(words[a]) == "cell") first[a] += 0.5 * step[a];
+    }
+    return first;
+}
+
+/// The spacing "axis mins" and "axis maxs" imply: the extent over n - 1 steps for node
+/// centering (the default), n steps for cell centering. Negative when max < min.
+Vec3 spacing_from_axis_range(const Field& mins, const Field& maxs, const Field* centers,
+                             const Index3& dims, const std::string& label)
+{
+    const Vec3 lo = parse_vec3(split_words(mins.value), label,
+                               str_cat("field \"axis mins\" (line ", mins.line, ")"), false);
+    const Vec3 hi = parse_vec3(split_words(maxs.value), label,
+                               str_cat("field \"axis maxs\" (line ", maxs.line, ")"), false);
+    const std::vector<std::string_view> words =
+        centers ? split_words(centers->value) : std::vector<std::string_view>{};
+    Vec3 step{};
+    for (std::size_t a = 0; a < 3; ++a) {
+        const bool cell = words.size() == 3 && lower_ascii(words[a]) == "cell";
+        step[a] = (hi[a] - lo[a]) / static_cast<double>(cell ? dims[a] : dims[a] - 1);
+    }
+    return step;
 }
 
 Vec3 parse_space_origin(const Field& field, const std::string& label)
@@ -302,6 +324,19 @@ std::uint64_t skip_lines(const ByteInput& file, std::uint64_t offset, std::int64
         pos += at;
     }
     return pos;
+}
+
+/// The 3D spaces NRRD names ("space: ..."); other names (MetaImage's "RAI") are not written.
+bool is_nrrd_space(std::string_view name)
+{
+    constexpr std::string_view kSpaces[] = {
+        "right-anterior-superior", "ras", "left-anterior-superior", "las",
+        "left-posterior-superior", "lps", "scanner-xyz", "3d-right-handed", "3d-left-handed",
+    };
+    const std::string lower = lower_ascii(name);
+    for (std::string_view s : kSpaces)
+        if (s == lower) return true;
+    return false;
 }
 
 std::string nrrd_type_name(ScalarType type)
@@ -445,11 +480,35 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
                             ") and \"space directions\" (line ", directions->line,
                             ") are given; NRRD allows only one"));
     }
-    if (spacings)
+    const Field* mins = find(fields, "axis mins");
+    const Field* maxs = find(fields, "axis maxs");
+    const Field* centers = find(fields, "centers");
+    if (mins && directions) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": both \"axis mins\" (line ", mins->line,
+                            ") and \"space directions\" (line ", directions->line,
+                            ") are given; NRRD places a spatial frame by \"space origin\""));
+    }
+    if (spacings) {
         grid.spacing = parse_vec3(split_words(spacings->value), label, "field \"spacings\"", true);
-    if (directions) grid.spacing = parse_space_directions(*directions, label);
-    if (const Field* origin = find(fields, "space origin"))
+    } else if (mins && maxs) {
+        const Vec3 step = spacing_from_axis_range(*mins, *maxs, centers, grid.dims, label);
+        set_frame(grid, {{{step[0], 0, 0}, {0, step[1], 0}, {0, 0, step[2]}}}, {1, 1, 1}, label,
+                  str_cat("fields \"axis mins\" and \"axis maxs\" (lines ", mins->line, " and ",
+                          maxs->line, ")"));
+    }
+    if (directions) {
+        set_frame(grid, parse_space_directions(*directions, label), {1, 1, 1}, label,
+                  str_cat("field \"space directions\" (line ", directions->line, ")"));
+    }
+    if (const Field* space = find(fields, "space")) grid.space = normalize_blanks(space->value);
+    if (const Field* origin = find(fields, "space origin")) {
         grid.origin = parse_space_origin(*origin, label);
+    } else if (mins) {
+        Vec3 step{}; // the frame is diagonal here: no space directions
+        for (std::size_t a = 0; a < 3; ++a) step[a] = grid.direction[a][a] * grid.spacing[a];
+        grid.origin = parse_axis_mins(*mins, centers, step, label);
+    }
 
     // Where the samples are.
     std::unique_ptr<ByteInput> detached;
@@ -499,17 +558,25 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
 void write_nrrd(const Volume& volume, const std::filesystem::path& path, bool detached)
 {
     const Index3& n = volume.dims();
-    const Vec3& s = volume.spacing();
+    const Mat3 m = frame_matrix(volume.spacing(), volume.direction());
     const Vec3& o = volume.origin();
     std::string header = "NRRD0004\n"
                          "# Complete NRRD file format specification at:\n"
                          "# http://teem.sourceforge.net/nrrd/format.html\n";
     header += "type: " + nrrd_type_name(volume.type()) + "\n";
     header += "dimension: 3\n";
-    header += "space dimension: 3\n";
+    if (!is_nrrd_space(volume.space())) {
+        header += "space dimension: 3\n";
+    } else {
+        header += "space: " + volume.space() + "\n";
+    }
     header += str_cat("sizes: ", n[0], ' ', n[1], ' ', n[2], '\n');
-    header += "space directions: (" + format_real(s[0]) + ",0,0) (0," + format_real(s[1]) +
-              ",0) (0,0," + format_real(s[2]) + ")\n";
+    header += "space directions:";
+    for (std::size_t a = 0; a < 3; ++a) {
+        header += " (" + format_real(m[0][a]) + "," + format_real(m[1][a]) + "," +
+                  format_real(m[2][a]) + ")";
+    }
+    header += "\n";
     header += "kinds: domain domain domain\n";
     if (type_size(volume.type()) > 1) header += "endian: little\n";
     header += "encoding: raw\n";

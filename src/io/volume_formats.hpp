@@ -14,6 +14,7 @@
 // Messages start with `label`: the file as the user named it, then ": data file X" when the
 // samples are in a second file, then ": " and what is wrong.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -93,13 +94,23 @@ bool is_file_pattern(std::string_view value);
 
 // ---- samples --------------------------------------------------------------------------------
 
-/// What a header says about the samples' type and place in space.
+/// What a header says about the samples' type and place in space (the frame of volume.hpp).
 struct Grid {
     ScalarType type = ScalarType::u8;
     Index3 dims{0, 0, 0};
     Vec3 spacing{1, 1, 1};
     Vec3 origin{0, 0, 0};
+    Mat3 direction = kIdentity3;
+    std::string space; ///< the named space, recorded for `info`
 };
+
+/// Sets grid.direction and grid.spacing from three axis vectors: axes[a] is the world step of
+/// axis a times 1 / scale[a] (scale = the spacings when the vectors are unit directions, 1 when
+/// they are the steps). Column a of the direction is axes[a] / |axes[a]|, spacing[a] is
+/// scale[a] * |axes[a]|. `what` names the field in messages.
+/// @throws Error{bad_format} for a zero vector or a degenerate frame (axes in one plane).
+void set_frame(Grid& grid, const std::array<Vec3, 3>& axes, const Vec3& scale, const std::string& label,
+               std::string_view what);
 
 enum class Encoding {
     raw,        ///< the bytes as they are

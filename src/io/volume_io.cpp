@@ -251,6 +251,32 @@ Vec3 parse_vec3(const std::vector<std::string_view>& words, const std::string& l
     return v;
 }
 
+void set_frame(Grid& grid, const std::array<Vec3, 3>& axes, const Vec3& scale, const std::string& label,
+               std::string_view what)
+{
+    Mat3 d{};
+    for (std::size_t a = 0; a < 3; ++a) {
+        const Vec3& v = axes[a];
+        const double norm = std::hypot(v[0], v[1], v[2]); // no underflow for tiny spacings
+        if (!(norm > 0) || !std::isfinite(norm)) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": ", what, ": the vector of axis ", a + 1, " (", format_real(v[0]), ",",
+                                format_real(v[1]), ",", format_real(v[2]),
+                                ") has no length; expected a non-zero direction per axis"));
+        }
+        for (std::size_t r = 0; r < 3; ++r) d[r][a] = v[r] / norm;
+        grid.spacing[a] = scale[a] * norm;
+    }
+    // |det| of unit columns is 1 for an orthogonal frame and 0 for axes in one plane
+    if (!(std::fabs(determinant(d)) > 1e-6)) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": ", what, ": the axis vectors lie in one plane (a degenerate frame, "
+                                               "determinant ",
+                            determinant(d), "); expected three independent directions"));
+    }
+    grid.direction = d;
+}
+
 std::uint64_t payload_bytes(const Index3& dims, ScalarType type, const std::string& label)
 {
     for (std::int64_t d : dims) {
@@ -313,7 +339,10 @@ namespace {
 Volume allocate(const Grid& grid, const std::string& label)
 {
     try {
-        return Volume(grid.type, grid.dims, grid.spacing, grid.origin);
+        Volume volume(grid.type, grid.dims, grid.spacing, grid.origin);
+        volume.set_direction(grid.direction);
+        volume.set_space(grid.space);
+        return volume;
     } catch (const Error& e) {
         throw Error(e.status(), label + ": " + e.what());
     }
@@ -465,7 +494,10 @@ Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& stor
         to_native(samples.get(), static_cast<std::size_t>(bytes / width), width, storage.endian);
         if (end) *end = storage.offset + stream;
         try {
-            return Volume(grid.type, grid.dims, grid.spacing, grid.origin, std::move(samples));
+            Volume volume(grid.type, grid.dims, grid.spacing, grid.origin, std::move(samples));
+            volume.set_direction(grid.direction);
+            volume.set_space(grid.space);
+            return volume;
         } catch (const Error& e) {
             throw Error(e.status(), label + ": " + e.what());
         }

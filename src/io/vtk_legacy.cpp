@@ -226,7 +226,10 @@ Volume read_vtk(const ByteInput& file)
             have_dims = true;
         } else if (equals_ignore_case(w[0], "SPACING") ||
                    equals_ignore_case(w[0], "ASPECT_RATIO")) {
-            grid.spacing = parse_vec3(values, label, what, true);
+            // a negative spacing flips its axis (vtkImageData allows it); 0 is degenerate
+            const Vec3 step = parse_vec3(values, label, what, false);
+            set_frame(grid, {{{step[0], 0, 0}, {0, step[1], 0}, {0, 0, step[2]}}}, {1, 1, 1}, label,
+                      what);
         } else if (equals_ignore_case(w[0], "ORIGIN")) {
             grid.origin = parse_vec3(values, label, what, false);
         } else if (equals_ignore_case(w[0], "POINT_DATA")) {
@@ -308,7 +311,14 @@ Volume read_vtk(const ByteInput& file)
 void write_vtk(const Volume& volume, const std::filesystem::path& path)
 {
     const Index3& n = volume.dims();
-    const Vec3& s = volume.spacing();
+    if (!is_diagonal(volume.direction())) {
+        throw Error(Status::unsupported_format,
+                    str_cat(path.string(),
+                            ": VTK STRUCTURED_POINTS cannot hold the volume's rotated frame (only "
+                            "ORIGIN and SPACING); write .nrrd or .mhd to keep it"));
+    }
+    Vec3 s = volume.spacing(); // signed: a flipped axis has a negative spacing
+    for (std::size_t a = 0; a < 3; ++a) s[a] *= volume.direction()[a][a];
     const Vec3& o = volume.origin();
     std::string header = "# vtk DataFile Version 3.0\n"
                          "cmc33 volume\n"

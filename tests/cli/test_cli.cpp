@@ -864,5 +864,115 @@ TEST(CliReliability, NoTopologyHelpAndAnEmptyMeshIsOriented)
     EXPECT_EQ(j["topology"]["closed"], false);
 }
 
+// ---- frames and extreme values (issue #9, items 1 and 3) -------------------------------------
+
+TEST(CliFrames, InfoPrintsTheFrameAndExtractMirrorsTheWinding)
+{
+    const fs::path dir = test::temp_dir();
+    Volume v = sphere_volume();
+    v.set_spacing({1, 1, 3});
+    v.set_direction(Mat3{{{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
+    v.set_space("left-posterior-superior");
+    const fs::path lps = dir / "lps.nrrd";
+    io::write_volume(v, lps);
+    const Result r = run("info " + quote(lps.string()));
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_NE(r.out.find("spacing (1, 1, 3)"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("space left-posterior-superior\n"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("directions (world direction of +i, +j, +k): i (-1, 0, 0) j (0, 1, 0) k (0, 0, 1)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("mirrored"), std::string::npos) << r.out;
+    const json j = parse(run("info " + quote(lps.string()) + " --json"));
+    EXPECT_EQ(j["direction"], json({{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}));
+    EXPECT_EQ(j["mirrored"], true);
+    EXPECT_EQ(j["space"], "left-posterior-superior");
+    // the identity frame prints no direction line
+    const Result plain = run("info " + quote(write_sphere(dir).string()));
+    EXPECT_EQ(plain.out.find("directions"), std::string::npos) << plain.out;
+
+    // the mesh is in world coordinates (x <= 0), closed and oriented
+    const fs::path mesh = dir / "lps.ply";
+    const Result e = run("extract " + quote(lps.string()) + " -i " + kIso + " -o " + quote(mesh.string()) + " --json");
+    ASSERT_EQ(e.code, 0) << e.err;
+    const json ej = parse(e);
+    EXPECT_EQ(ej["topology"]["oriented"], true);
+    EXPECT_EQ(ej["topology"]["euler"], 2);
+    const Mesh m = io::read_mesh(mesh);
+    for (std::size_t i = 0; i < m.positions.size(); i += 3) ASSERT_LE(m.positions[i], 0.0f);
+}
+
+TEST(CliExtreme, DoublesSpanningTheWholeRange)
+{
+    const fs::path dir = test::temp_dir();
+    // +-1e308 in an ambiguous pattern: differences overflow
+    Volume v(ScalarType::f64, {4, 4, 4});
+    for (std::int64_t i = 0; i < v.sample_count(); ++i) {
+        v.samples<double>()[i] = ((i * 7 + i / 4 + i / 16) % 3 == 0 ? -1 : 1) * 1e308 * (1 + 0.01 * static_cast<double>(i % 5));
+    }
+    v.samples<double>()[0] = -std::numeric_limits<double>::max();
+    v.samples<double>()[1] = std::numeric_limits<double>::max();
+    const fs::path file = dir / "huge.nrrd";
+    io::write_volume(v, file);
+
+    const Result info = run("info " + quote(file.string()));
+    ASSERT_EQ(info.code, 0) << info.err;
+    EXPECT_EQ(info.out.find("nan"), std::string::npos) << info.out;
+    EXPECT_EQ(info.out.find("inf"), std::string::npos) << info.out;
+    const json ij = parse(run("info " + quote(file.string()) + " --json"));
+    std::int64_t total = 0;
+    for (const json& bin : ij["histogram"]) {
+        total += bin["count"].get<std::int64_t>();
+        EXPECT_TRUE(bin["lo"].is_number()) << bin;
+    }
+    EXPECT_EQ(total, 64);
+
+    const fs::path mesh = dir / "huge.ply";
+    const Result e = run("extract " + quote(file.string()) + " -i 0 --normals -o " + quote(mesh.string()));
+    ASSERT_EQ(e.code, 0) << e.err;
+    const Mesh m = io::read_mesh(mesh);
+    ASSERT_GT(m.vertex_count(), 0u);
+    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+        const double n = std::hypot(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]);
+        ASSERT_NEAR(n, 1.0, 1e-5) << "vertex " << i;
+        // edge vertices (one coordinate off the grid) sit near the middle of their edges: the
+        // values are of equal size and opposite signs, so no crossing is snapped to a corner
+        int off_grid = 0;
+        double frac = 0;
+        for (std::size_t k = 0; k < 3; ++k) {
+            const double f = m.positions[3 * i + k] - std::floor(m.positions[3 * i + k]);
+            if (f != 0) ++off_grid, frac = f;
+        }
+        if (off_grid == 1) {
+            ASSERT_GT(std::min(frac, 1 - frac), 0.3) << "vertex " << i;
+        }
+    }
+
+    // a face with every value near +-1e308: its saddle is printed, not -nan
+    const Result cell = run("cell 1e308 -1e308 -1e308 1e308 -1.5e308 1.7e308 1.7e308 -1.5e308");
+    ASSERT_EQ(cell.code, 0) << cell.err;
+    EXPECT_EQ(cell.out.find("nan"), std::string::npos) << cell.out;
+    EXPECT_NE(cell.out.find("ambiguous, saddle 0,"), std::string::npos) << cell.out;
+    // and the interior test's numbers (case 13 at 1e308): roots and t_max, no NaN
+    const Result tunnel = run("cell -0.5e308 0.2e308 0.3e308 -0.4e308 0.6e308 -0.1e308 -0.7e308 0.8e308");
+    ASSERT_EQ(tunnel.code, 0) << tunnel.err;
+    EXPECT_EQ(tunnel.out.find("nan"), std::string::npos) << tunnel.out;
+    EXPECT_NE(tunnel.out.find("t_max = -b/2a = 0.3676471"), std::string::npos) << tunnel.out;
+}
+
+TEST(CliExtreme, CoordinatesBeyondFloatAreRefusedNamingTheFile)
+{
+    const fs::path dir = test::temp_dir();
+    Volume v = sphere_volume();
+    v.set_spacing({1e300, 1, 1});
+    const fs::path file = dir / "wide.nrrd";
+    io::write_volume(v, file);
+    const fs::path mesh = dir / "wide.ply";
+    const Result r = run("extract " + quote(file.string()) + " -i " + kIso + " -o " + quote(mesh.string()));
+    expect_failure(r, "wide.nrrd");
+    EXPECT_NE(r.err.find("32-bit floats"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(mesh));
+}
+
 } // namespace
 } // namespace cmc33

@@ -282,6 +282,8 @@ TEST(VolumeReaders, NrrdGzipWithSpaceDirectionsAndOrigin)
     EXPECT_EQ(v.type(), ScalarType::i16);
     EXPECT_EQ(v.dims(), (Index3{3, 4, 5}));
     EXPECT_EQ(v.spacing(), (Vec3{0.75, 0.75, 2.5})); // the norms of the directions
+    EXPECT_EQ(v.direction(), (Mat3{{{1, 0, 0}, {0, 1, 0}, {0, 0, -1}}})); // and their signs
+    EXPECT_EQ(v.space(), "left-posterior-superior");
     EXPECT_EQ(v.origin(), (Vec3{-10.5, 20, 100}));
     EXPECT_EQ(samples_of<std::int16_t>(v), values);
 }
