@@ -112,8 +112,9 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
 inline double face_saddle(const double* raw, double iso, int f)
 {
     const auto p = face_cycle(f);
-    const long double A = static_cast<long double>(raw[p[0]]) - iso, B = static_cast<long double>(raw[p[1]]) - iso,
-                      C = static_cast<long double>(raw[p[2]]) - iso, D = static_cast<long double>(raw[p[3]]) - iso;
+    const long double i = static_cast<long double>(iso);
+    const long double A = static_cast<long double>(raw[p[0]]) - i, B = static_cast<long double>(raw[p[1]]) - i,
+                      C = static_cast<long double>(raw[p[2]]) - i, D = static_cast<long double>(raw[p[3]]) - i;
     return static_cast<double>((A * C - B * D) / (A + C - B - D));
 }
 
@@ -267,7 +268,7 @@ inline void report_numbers(const double* raw, double iso, double t_lewiner, cons
 {
     using L = long double;
     L vl[8];
-    for (int q = 0; q < 8; ++q) vl[q] = static_cast<L>(raw[q]) - iso;
+    for (int q = 0; q < 8; ++q) vl[q] = static_cast<L>(raw[q]) - static_cast<L>(iso);
     const SweepT<L> s(vl, var.axis, var.corner), lewiner(vl, var.lewiner_axis, var.lewiner_corner);
     r.tested = true;
     r.test = var.test == kTestTunnel ? "tunnel" : "13.5";
@@ -279,9 +280,9 @@ inline void report_numbers(const double* raw, double iso, double t_lewiner, cons
     r.t_max = static_cast<double>(t_max);
     r.f_t_max = a != 0 ? static_cast<double>(s.F(t_max)) : kNaN;
     r.t_alt = t_lewiner;
-    r.f_t_alt = static_cast<double>(lewiner.F(t_lewiner));
+    r.f_t_alt = static_cast<double>(lewiner.F(static_cast<L>(t_lewiner)));
     r.t1 = r.t2 = kNaN;
-    L t1 = kNaN, t2 = kNaN;
+    L t1 = static_cast<L>(kNaN), t2 = static_cast<L>(kNaN);
     const L disc = b * b - 4 * a * c;
     if (a != 0 && disc >= 0) {
         const L q = -0.5L * (b + std::copysign(std::sqrt(disc), b)); // stable roots

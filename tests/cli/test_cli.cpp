@@ -933,14 +933,14 @@ TEST(CliExtreme, DoublesSpanningTheWholeRange)
     const Mesh m = io::read_mesh(mesh);
     ASSERT_GT(m.vertex_count(), 0u);
     for (std::size_t i = 0; i < m.vertex_count(); ++i) {
-        const double n = std::hypot(m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]);
+        const double n = std::hypot(double(m.normals[3 * i]), double(m.normals[3 * i + 1]), double(m.normals[3 * i + 2]));
         ASSERT_NEAR(n, 1.0, 1e-5) << "vertex " << i;
         // edge vertices (one coordinate off the grid) sit near the middle of their edges: the
         // values are of equal size and opposite signs, so no crossing is snapped to a corner
         int off_grid = 0;
         double frac = 0;
         for (std::size_t k = 0; k < 3; ++k) {
-            const double f = m.positions[3 * i + k] - std::floor(m.positions[3 * i + k]);
+            const double x = static_cast<double>(m.positions[3 * i + k]), f = x - std::floor(x);
             if (f != 0) ++off_grid, frac = f;
         }
         if (off_grid == 1) {

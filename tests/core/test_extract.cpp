@@ -78,8 +78,8 @@ TEST(Extract, NormalsPointFromAboveToBelow)
     ASSERT_EQ(mesh.normals.size(), mesh.positions.size());
     const double c = 9.5;
     for (std::size_t i = 0; i < mesh.vertex_count(); ++i) {
-        const double n[3] = {mesh.normals[3 * i], mesh.normals[3 * i + 1], mesh.normals[3 * i + 2]};
-        const double p[3] = {mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]};
+        const double n[3] = {double(mesh.normals[3 * i]), double(mesh.normals[3 * i + 1]), double(mesh.normals[3 * i + 2])};
+        const double p[3] = {double(mesh.positions[3 * i]), double(mesh.positions[3 * i + 1]), double(mesh.positions[3 * i + 2])};
         EXPECT_NEAR(std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), 1.0, 1e-5);
         EXPECT_LT(n[0] * (p[0] - c) + n[1] * (p[1] - c) + n[2] * (p[2] - c), 0.0);
     }

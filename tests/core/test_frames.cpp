@@ -232,7 +232,7 @@ TEST(ExtremeValues, SamplesNearTheDoubleLimitGiveTheirScaledGridsMesh)
                 ASSERT_NEAR(a.normals[i], b.normals[i], 1e-6) << "normal coordinate " << i;
             }
             for (std::size_t i = 0; i < a.normals.size(); i += 3) {
-                const double len = std::hypot(a.normals[i], a.normals[i + 1], a.normals[i + 2]);
+                const double len = std::hypot(double(a.normals[i]), double(a.normals[i + 1]), double(a.normals[i + 2]));
                 ASSERT_NEAR(len, 1.0, 1e-5) << "vertex " << i / 3; // no zero normals
             }
         }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -605,7 +606,7 @@ TEST(FieldTopology, RejectsBadArguments)
         EXPECT_NE(std::string(e.what()).find("8x1x1"), std::string::npos) << e.what();
     }
     v[5] = std::nan("");
-    v[6] = INFINITY;
+    v[6] = std::numeric_limits<double>::infinity();
     try {
         field_topology(GridView<double>::dense(v.data(), {2, 2, 2}), 0.0);
         ADD_FAILURE() << "no exception";

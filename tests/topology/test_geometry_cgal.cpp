@@ -341,8 +341,8 @@ std::int64_t add_piercing_copy(Mesh& m)
     std::array<std::array<double, 3>, 3> s{}, l{};
     for (std::size_t i = 0; i < 3; ++i)
         for (std::size_t k = 0; k < 3; ++k) {
-            s[i][k] = m.positions[3 * m.triangles[3 * small + i] + k];
-            l[i][k] = m.positions[3 * m.triangles[3 * large + i] + k];
+            s[i][k] = static_cast<double>(m.positions[3 * m.triangles[3 * small + i] + k]);
+            l[i][k] = static_cast<double>(m.positions[3 * m.triangles[3 * large + i] + k]);
         }
     std::array<double, 3> c{}, e1{}, e2{}, n{};
     for (std::size_t k = 0; k < 3; ++k) {

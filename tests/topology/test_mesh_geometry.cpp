@@ -415,7 +415,7 @@ Pairs brute_force_pairs(const Mesh& m)
         const std::array<float, 3> p{m.positions[3 * v] + 0.0f, m.positions[3 * v + 1] + 0.0f,
                                      m.positions[3 * v + 2] + 0.0f};
         const auto [it, inserted] = ids.emplace(p, static_cast<std::uint32_t>(points.size()));
-        if (inserted) points.push_back({p[0], p[1], p[2]});
+        if (inserted) points.push_back({double(p[0]), double(p[1]), double(p[2])});
         welded[v] = it->second;
     }
     const std::size_t n = m.triangle_count();
@@ -638,7 +638,7 @@ TEST(MeshGeometryPredicates, Orient3dMatchesRationalsOnNearCoplanarPoints)
                 y = jiggle(y, rng);
                 z = jiggle(z, rng);
             }
-            pt = {x, y, z};
+            pt = {double(x), double(y), double(z)};
         }
         const int expected = orient3d_reference(p[0], p[1], p[2], p[3]);
         const int got = cmc33::detail::orient3d(p[0], p[1], p[2], p[3]);
@@ -669,8 +669,8 @@ TEST(MeshGeometryPredicates, CoplanarTrianglesWithLargeCoordinates)
     // a fold-over across the shared edge (0, 1): third corners on the same side
     const std::vector<P> pts{pt(0, 0), pt(1, 0.125), pt(0.25, 1), pt(0.875, 0.75), pt(0.5, -1)};
     for (const P& p : pts) ASSERT_EQ(double(p[2]) - double(p[0]) - double(p[1]), 0.0) << "not exact";
-    const std::array<Point3, 4> d{Point3{pts[0][0], pts[0][1], pts[0][2]}, Point3{pts[1][0], pts[1][1], pts[1][2]},
-                                  Point3{pts[2][0], pts[2][1], pts[2][2]}, Point3{pts[3][0], pts[3][1], pts[3][2]}};
+    const std::array<Point3, 4> d{Point3{double(pts[0][0]), double(pts[0][1]), double(pts[0][2])}, Point3{double(pts[1][0]), double(pts[1][1]), double(pts[1][2])},
+                                  Point3{double(pts[2][0]), double(pts[2][1]), double(pts[2][2])}, Point3{double(pts[3][0]), double(pts[3][1]), double(pts[3][2])}};
     ASSERT_EQ(orient3d_reference(d[0], d[1], d[2], d[3]), 0);
     auto& stats = cmc33::detail::predicate_stats();
     const auto before = stats;
@@ -681,7 +681,7 @@ TEST(MeshGeometryPredicates, CoplanarTrianglesWithLargeCoordinates)
     // corner 3 moved off the plane by one ulp in z: a hinge, no overlap
     std::vector<P> lifted = pts;
     lifted[3][2] = up(lifted[3][2]);
-    const Point3 l3{lifted[3][0], lifted[3][1], lifted[3][2]};
+    const Point3 l3{double(lifted[3][0]), double(lifted[3][1]), double(lifted[3][2])};
     ASSERT_NE(orient3d_reference(d[0], d[1], d[2], l3), 0);
     EXPECT_EQ(cmc33::detail::orient3d(d[0], d[1], d[2], l3), orient3d_reference(d[0], d[1], d[2], l3));
     EXPECT_EQ(geometry(make_mesh(lifted, {0, 1, 2, 1, 0, 3})).intersecting_pairs, 0);
@@ -706,7 +706,7 @@ TEST(MeshGeometryPredicates, VeryDifferentExponentsTakeTheRationalPath)
     EXPECT_EQ(stats.rational, before.rational + 1);
     // d one float ulp off the plane, either way
     for (float dz : {up(static_cast<float>(d[2])), down(static_cast<float>(d[2]))}) {
-        const Point3 e{d[0], d[1], dz};
+        const Point3 e{d[0], d[1], double(dz)};
         const int expected = orient3d_reference(a, b, c, e);
         ASSERT_NE(expected, 0);
         EXPECT_EQ(cmc33::detail::orient3d(a, b, c, e), expected);
@@ -729,7 +729,7 @@ TEST(MeshGeometryPredicates, SegmentMeetsTriangle)
     EXPECT_TRUE(segment_meets_triangle({0.5, 0.5, -1}, {0.5, 0.5, 1}, a, b, c));
     EXPECT_TRUE(segment_meets_triangle({0.5, 0.5, 0}, {0.5, 0.5, 1}, a, b, c));  // endpoint on it
     EXPECT_TRUE(segment_meets_triangle({1, 1, -1}, {1, 1, 1}, a, b, c));         // through the hypotenuse
-    EXPECT_FALSE(segment_meets_triangle({1, up(1.0f), -1}, {1, up(1.0f), 1}, a, b, c));
+    EXPECT_FALSE(segment_meets_triangle({1, double(up(1.0f)), -1}, {1, double(up(1.0f)), 1}, a, b, c));
     EXPECT_TRUE(segment_meets_triangle({-1, 0, 0}, {3, 0, 0}, a, b, c));         // along an edge
     EXPECT_TRUE(segment_meets_triangle({-1, 1, 0}, {3, 1, 0}, a, b, c));         // across, coplanar
     EXPECT_FALSE(segment_meets_triangle({-1, -1, 0}, {3, -1, 0}, a, b, c));      // coplanar, outside
