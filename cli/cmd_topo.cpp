@@ -41,8 +41,9 @@ void run_topo(const TopoArgs& args)
     std::cout << args.input << ": " << t.vertices << " vertices, " << t.edges << " edges, " << t.faces
               << " faces";
     if (static_cast<std::int64_t>(mesh.vertex_count()) != t.vertices) {
-        std::cout << " (the file has " << mesh.vertex_count() << " vertices; "
-                  << static_cast<std::int64_t>(mesh.vertex_count()) - t.vertices << " are used by no triangle)";
+        const std::int64_t unused = static_cast<std::int64_t>(mesh.vertex_count()) - t.vertices;
+        std::cout << " (the file has " << mesh.vertex_count() << " vertices; " << unused
+                  << (unused == 1 ? " is" : " are") << " used by no triangle)";
     }
     std::cout << '\n'
               << "euler " << t.euler << ", betti " << t.components << " " << t.b1 << " " << t.closed_components

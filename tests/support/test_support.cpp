@@ -49,6 +49,25 @@ std::filesystem::path temp_dir()
     return dir;
 }
 
+const std::vector<VolumeCase>& shared_volume_cases()
+{
+    static const std::vector<VolumeCase> cases = {
+        {"aneurism_256x256x256_uint8.nrrd", 80},  {"bonsai_256x256x256_uint8.nrrd", 40},
+        {"engine_256x256x128_uint8.nrrd", 80},    {"tooth_103x94x161_uint8.nrrd", 120},
+        {"nucleon_41x41x41_uint8.nrrd", 100},     {"silicium_98x34x34_uint8.nrrd", 100},
+        {"CThead_256x256x113_uint16.nrrd", 650},  {"headsq_quarter_64x64x93_uint16.nrrd", 500},
+        {"ironProt_68x68x68_uint8.nrrd", 96},     {"neghip_66x66x66_uint8.nrrd", 90},
+        {"Bucky_32x32x32_uint8.nrrd", 100},       {"HeadMRVolume_48x62x42_uint8.nrrd", 40},
+        {"mri_head_256x256x256_uint8.nrrd", 38},  {"LIDC2_256x256x133_uint8.nrrd", 60},
+        {"stent_128x128x256_int16.nrrd", 250},    {"walnut_128x96x114_uint16.nrrd", 5000},
+        {"stagbeetle_138x138x82_uint16.nrrd", 900}, {"Cranium_256x256x108_int16.nrrd", 226},
+        {"ch2_181x217x181_uint8.nrrd", 30},
+    };
+    return cases;
+}
+
+void PrintTo(const VolumeCase& c, std::ostream* os) { *os << c.file << " at iso " << c.iso; }
+
 std::optional<std::filesystem::path> shared_volume(const std::string& file_name)
 {
     const char* shared = std::getenv("CMC33_SHARED");

@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <ostream>
 #include <string>
+#include <vector>
 
 #include "cmc33/volume.hpp"
 
@@ -13,6 +15,15 @@ namespace cmc33::test {
 
 /// A fresh, empty folder for the running test (removed at the start of the next run).
 std::filesystem::path temp_dir();
+
+/// A shared volume and an isovalue from its README (an integer; tests also run iso + 0.5).
+struct VolumeCase {
+    const char* file;
+    double iso;
+};
+/// Every volume of ../shared/data/volumes with one README isovalue each.
+const std::vector<VolumeCase>& shared_volume_cases();
+void PrintTo(const VolumeCase& c, std::ostream* os);
 
 /// Path of a volume in ../shared/data/volumes, or nullopt when shared/ is not beside the repo.
 std::optional<std::filesystem::path> shared_volume(const std::string& file_name);

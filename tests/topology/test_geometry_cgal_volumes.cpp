@@ -25,23 +25,8 @@ namespace {
 using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<K::Point_3>;
 
-struct Case {
-    const char* file;
-    double iso; // an integer; the test also runs iso + 0.5
-};
+using Case = cmc33::test::VolumeCase; // an integer iso; the test also runs iso + 0.5
 
-const Case kCases[] = {
-    {"aneurism_256x256x256_uint8.nrrd", 80},  {"bonsai_256x256x256_uint8.nrrd", 40},
-    {"engine_256x256x128_uint8.nrrd", 80},    {"tooth_103x94x161_uint8.nrrd", 120},
-    {"nucleon_41x41x41_uint8.nrrd", 100},     {"silicium_98x34x34_uint8.nrrd", 100},
-    {"CThead_256x256x113_uint16.nrrd", 650},  {"headsq_quarter_64x64x93_uint16.nrrd", 500},
-    {"ironProt_68x68x68_uint8.nrrd", 96},     {"neghip_66x66x66_uint8.nrrd", 90},
-    {"Bucky_32x32x32_uint8.nrrd", 100},       {"HeadMRVolume_48x62x42_uint8.nrrd", 40},
-    {"mri_head_256x256x256_uint8.nrrd", 38},  {"LIDC2_256x256x133_uint8.nrrd", 60},
-    {"stent_128x128x256_int16.nrrd", 250},    {"walnut_128x96x114_uint16.nrrd", 5000},
-    {"stagbeetle_138x138x82_uint16.nrrd", 900}, {"Cranium_256x256x108_int16.nrrd", 226},
-    {"ch2_181x217x181_uint8.nrrd", 30},
-};
 
 class CgalVolume : public ::testing::TestWithParam<Case> {};
 
@@ -77,7 +62,7 @@ TEST_P(CgalVolume, EmbeddedForUsAndForCgal)
     }
 }
 
-INSTANTIATE_TEST_SUITE_P(SharedVolumes, CgalVolume, ::testing::ValuesIn(kCases), [](const auto& p) {
+INSTANTIATE_TEST_SUITE_P(SharedVolumes, CgalVolume, ::testing::ValuesIn(cmc33::test::shared_volume_cases()), [](const auto& p) {
     std::string name = p.param.file;
     return name.substr(0, name.find('_'));
 });
