@@ -17,6 +17,7 @@ enum class Status {
     unsupported_format, ///< a valid but unsupported variant (encoding, type, extension)
     non_finite,         ///< NaN or infinity in samples or parameters
     too_large,          ///< sizes that overflow or exceed what can be allocated
+    cancelled,          ///< the caller's progress callback asked to stop
     internal,           ///< a broken invariant: a bug in cmc33
 };
 

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string_view>
 
 #include "cmc33/mesh.hpp"
@@ -29,10 +30,23 @@ Method parse_method(std::string_view name);
 inline constexpr int kSubcaseCount = 33;
 std::string_view subcase_name(int subcase) noexcept;
 
+/// Runs task(0), ..., task(n - 1), possibly at the same time, and returns when all have returned.
+/// If tasks throw, it rethrows one of their exceptions after all have ended. The default
+/// (an empty Executor) starts one std::thread per task; a caller can run the tasks on its own pool
+/// (TBB, vtkSMPTools, a Python executor) instead.
+using Executor = std::function<void(int n, const std::function<void(int task)>& task)>;
+
+/// Called with the fraction of the work done, in [0, 1], from one of the tasks' threads (never two
+/// calls at once, at most every few milliseconds); return false to stop: extract() then throws
+/// Error{cancelled} and returns no mesh.
+using Progress = std::function<bool(double fraction)>;
+
 struct ExtractOptions {
     Method method = Method::cmc33;
     bool normals = false; ///< per-vertex normals from the field's gradient (central differences)
     int threads = 0;      ///< 0: all cores. The mesh is byte-identical for every thread count.
+    Progress progress{};  ///< optional: progress and cancellation
+    Executor executor{};  ///< optional: where the `threads` tasks run
 };
 
 struct ExtractStats {
@@ -48,8 +62,10 @@ struct ExtractStats {
 ///
 /// @param grid  at least 2 samples on each axis
 /// @throws Error{invalid_argument} if an axis has < 2 samples; Error{non_finite} if iso or a
-///         sample is NaN or infinite (the message says how many and where the first is)
+///         sample is NaN or infinite (the message says how many and where the first is);
+///         Error{cancelled} if options.progress returned false
 /// Cost: O(cells) time; working memory O(slices); no allocation inside a pass.
+/// The composition of the passes of passes.hpp over `threads` ranges of sample planes.
 template <class T>
 Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
 Mesh extract(const Volume& volume, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);

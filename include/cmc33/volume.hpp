@@ -67,12 +67,13 @@ inline bool is_diagonal(const Mat3& m) noexcept
     return m[0][1] == 0 && m[0][2] == 0 && m[1][0] == 0 && m[1][2] == 0 && m[2][0] == 0 && m[2][1] == 0;
 }
 
-/// Non-owning view of samples of type T. Unit x-stride is required; y and z strides are in
-/// elements, so a view can cover a sub-block of a larger array without copying.
+/// Non-owning view of samples of type T. Strides are in elements and may be anything, negative
+/// included (a numpy view such as vol[:, ::2, 10:200], Fortran order, a sub-block of a larger
+/// array): `data` points at sample (0, 0, 0). Unit x-stride is the fast case.
 template <class T> struct GridView {
     const T* data = nullptr;
     Index3 dims{0, 0, 0};    ///< samples along x, y, z
-    Index3 strides{1, 0, 0}; ///< element strides; strides[0] must be 1
+    Index3 strides{1, 0, 0}; ///< element strides along x, y, z
     Vec3 spacing{1, 1, 1};
     Vec3 origin{0, 0, 0};
     Mat3 direction = kIdentity3; ///< column a: world direction of +axis a (see the file comment)
@@ -88,7 +89,7 @@ template <class T> struct GridView {
     std::int64_t nz() const noexcept { return dims[2]; }
     std::int64_t offset(std::int64_t i, std::int64_t j, std::int64_t k) const noexcept
     {
-        return i + j * strides[1] + k * strides[2];
+        return i * strides[0] + j * strides[1] + k * strides[2];
     }
     T operator()(std::int64_t i, std::int64_t j, std::int64_t k) const noexcept { return data[offset(i, j, k)]; }
 };

@@ -1,15 +1,16 @@
-// extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges):
-//   1. classify + decide + count: per row of cells, the case code of each cell from the rows'
-//      above-flags (rows whose samples are all on one side are skipped), the face and interior
-//      tests of the cells that have them, and the number of vertices (crossed edges owned by the
-//      row's samples, interior vertices) and triangles;
-//   2. scan: prefix sums give every row its first vertex and first triangle;
-//   3. emit vertices: each crossed grid edge is owned by its lower sample and gets one vertex;
-//   4. emit triangles: every cell writes its tiling's triangles and interior vertices at its row's
-//      offsets, finding edge vertices by edge ownership (no hash map, no locks). Tested cells are
-//      decided again rather than stored: working memory is O(rows + threads * nx), not O(cells).
-// Rows are processed in parallel by z-slab; all writes land at offsets fixed by pass 2, so the mesh
-// is the same, byte for byte, for every thread count.
+// extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges), public in
+// include/cmc33/passes.hpp, each over a range of sample planes [k0, k1):
+//   1. count: per row of cells, the case code of each cell from the rows' above-flags (rows whose
+//      samples are all on one side are skipped), the face and interior tests of the cells that
+//      have them, and the number of vertices (crossed edges owned by the row's samples, interior
+//      vertices) and triangles; a scan inside the range gives every row its first ids;
+//   2. scan: consecutive ranges get consecutive first vertex and triangle ids;
+//   3. emit: each crossed grid edge is owned by its lower sample and gets one vertex; every cell
+//      writes its tiling's triangles and interior vertices at its row's offsets, finding edge
+//      vertices by edge ownership (no hash map, no locks). Tested cells are decided again rather
+//      than stored: working memory is O(rows + threads * nx * ny), not O(cells).
+// extract() runs `threads` ranges as tasks; all writes land at offsets fixed by the scan, so the
+// mesh is the same, byte for byte, for every thread count and every split.
 //
 // World coordinates (volume.hpp): x = origin + M * (i, j, k) with M = D * diag(spacing). A diagonal
 // M (the usual axis-aligned frame, flips included) takes the per-axis multiply of old; only an
@@ -19,17 +20,23 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <thread>
 #include <type_traits>
 #include <vector>
 
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
+#include "cmc33/passes.hpp"
 #include "core/cube.hpp"
 #include "core/decide.hpp"
 #include "core/parallel.hpp"
@@ -58,8 +65,8 @@ public:
             }
         }
     }
-    /// flags[i] = 1 if row[i] is above, else 0.
-    void row(const T* row, std::int64_t n, std::uint8_t* flags) const
+    /// flags[i] = 1 if row[i * stride] is above, else 0.
+    void row(const T* row, std::int64_t n, std::int64_t stride, std::uint8_t* flags) const
     {
         if constexpr (std::is_integral_v<T>) {
             if (mode_ != Mode::compare) {
@@ -67,10 +74,19 @@ public:
                 return;
             }
             const T t = threshold_;
-            for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i] >= t);
+            if (stride == 1) {
+                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i] >= t);
+            } else {
+                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i * stride] >= t);
+            }
         } else {
             const double iso = iso_;
-            for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i]) >= iso);
+            if (stride == 1) {
+                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i]) >= iso);
+            } else {
+                for (std::int64_t i = 0; i < n; ++i)
+                    flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i * stride]) >= iso);
+            }
         }
     }
 
@@ -176,16 +192,111 @@ template <class T> double largest_coordinate(const GridView<T>& g)
     return largest;
 }
 
-template <class T> class Extractor {
+/// x and y edges owned by a sample row that cross: from its above-flags (f) and those of the row
+/// at j + 1 (fy; pass f at the last row, whose y edges do not exist).
+inline std::uint32_t xy_crossings(const std::uint8_t* f, const std::uint8_t* fy, std::int64_t nx)
+{
+    // flags are 0 or 1, so != is ^ and the narrow sums vectorise
+    std::uint32_t n = 0;
+    for (std::int64_t i = 0; i + 1 < nx; ++i) n += static_cast<std::uint32_t>(f[i] ^ f[i + 1]);
+    for (std::int64_t i = 0; i < nx; ++i) n += static_cast<std::uint32_t>(f[i] ^ fy[i]);
+    return n;
+}
+
+/// Progress over the planes of both passes, shared by extract()'s tasks: every task ticks once per
+/// plane; whoever ticks when no other task is reporting, and at least kInterval after the last
+/// report, calls the caller's callback. A false answer stops every task at its next plane.
+class Ticker {
 public:
-    Extractor(const GridView<T>& g, double iso, const ExtractOptions& opt, double largest_sample)
-        : g_(g), iso_(iso), above_(iso), opt_(opt), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()),
-          threads_(detail::resolve_threads(opt.threads)), m_(frame_matrix(g.spacing, g.direction)),
-          diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0), delta_(min_crossing(g, m_))
+    Ticker(const Progress& progress, std::int64_t total) : progress_(progress), total_(std::max<std::int64_t>(total, 1)) {}
+    /// One plane done; false when the work is to stop.
+    bool tick()
+    {
+        done_.fetch_add(1, std::memory_order_relaxed);
+        if (!progress_) return true;
+        if (cancelled_.load(std::memory_order_relaxed)) return false;
+        std::unique_lock lock(mutex_, std::try_to_lock);
+        if (!lock.owns_lock()) return true;
+        const auto now = std::chrono::steady_clock::now();
+        if (now - last_ < kInterval) return true;
+        last_ = now;
+        // read under the lock, so that the reported fractions never decrease
+        const std::int64_t done = std::min(done_.load(std::memory_order_relaxed), total_);
+        if (!progress_(static_cast<double>(done) / static_cast<double>(total_))) {
+            cancelled_.store(true, std::memory_order_relaxed);
+        }
+        return !cancelled_.load(std::memory_order_relaxed);
+    }
+    bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
+    /// The final call, with 1 (not if the caller already stopped the work).
+    void finish()
+    {
+        if (progress_ && !cancelled() && !progress_(1.0)) cancelled_.store(true, std::memory_order_relaxed);
+    }
+
+private:
+    static constexpr std::chrono::milliseconds kInterval{20};
+    const Progress& progress_;
+    std::int64_t total_;
+    std::atomic<std::int64_t> done_{0};
+    std::atomic<bool> cancelled_{false};
+    std::mutex mutex_;
+    std::chrono::steady_clock::time_point last_{};
+};
+
+[[noreturn]] void throw_cancelled()
+{
+    throw Error(Status::cancelled, "extraction cancelled by the progress callback");
+}
+
+/// Runs task(0..n-1) on the caller's executor, or on one std::thread each (the first on the
+/// calling thread); rethrows the first task's exception (by task index) once all have ended, so
+/// the error does not depend on the executor's scheduling.
+template <class Task> void run_tasks(int n, const Executor& executor, Task&& task)
+{
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(n));
+    const std::function<void(int)> guarded = [&](int t) {
+        try {
+            task(t);
+        } catch (...) {
+            errors[static_cast<std::size_t>(t)] = std::current_exception();
+        }
+    };
+    if (executor) {
+        executor(n, guarded);
+    } else if (n == 1) {
+        guarded(0);
+    } else {
+        std::vector<std::thread> pool;
+        pool.reserve(static_cast<std::size_t>(n - 1));
+        try {
+            for (int t = 1; t < n; ++t) pool.emplace_back(guarded, t);
+        } catch (...) {
+            for (auto& th : pool) th.join();
+            throw Error(Status::too_large, "cannot start " + std::to_string(n) + " threads");
+        }
+        guarded(0);
+        for (auto& th : pool) th.join();
+    }
+    for (auto& e : errors) {
+        if (e) std::rethrow_exception(e);
+    }
+}
+
+} // namespace
+
+/// The passes of passes.hpp for one grid and isovalue: what does not depend on the range (the
+/// frame, the sign rule, which configurations need the samples) is set up once and shared by the
+/// ranges, which may run at the same time (every method is const).
+template <class T> class RangeExtractor {
+public:
+    RangeExtractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
+        : g_(g), iso_(iso), above_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
+          m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
+          delta_(min_crossing(g, m_))
     {
         for (std::size_t a = 0; a < 3; ++a) step_[a] = diagonal_ ? m_[a][a] : 1.0;
         if (!diagonal_) normal_map_ = inverse_transpose(m_);
-        gradient_scale_ = gradient_scale(largest_sample);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
             needs_values_[code] = opt.method != Method::mc &&
@@ -193,62 +304,99 @@ public:
         }
     }
 
-    Mesh run(ExtractStats* stats)
+    /// Whether `c` was counted on a grid with these rows.
+    static bool same_rows(const RangeCounts& c, const GridView<T>& g)
     {
-        const std::int64_t rows = ny_ * nz_;
-        row_vertices_.assign(static_cast<std::size_t>(rows) + 1, 0);
-        row_triangles_.assign(static_cast<std::size_t>(rows) + 1, 0);
-        range_.assign(static_cast<std::size_t>(rows), {0, 0});
-        std::vector<ExtractStats> per_thread(static_cast<std::size_t>(threads_));
+        return c.nx_ == g.nx() && c.ny_ == g.ny() && c.rows_.size() == static_cast<std::size_t>((c.k1_ - c.k0_) * g.ny()) &&
+               (c.k1_ == g.nz() || c.seam_first_.size() == static_cast<std::size_t>(g.ny()) + 1);
+    }
 
-        // Pass 1: classify, decide, count.
-        detail::parallel_chunks(nz_, threads_, [&](int t, std::int64_t k0, std::int64_t k1) {
-            Scratch scratch(nx_, ny_);
-            for (std::int64_t k = k0; k < k1; ++k)
-                for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, scratch, per_thread[static_cast<std::size_t>(t)]);
-        });
-        if (stats) {
-            *stats = {};
-            for (const auto& s : per_thread)
-                for (std::size_t i = 0; i < static_cast<std::size_t>(kSubcaseCount); ++i) {
-                    stats->cells_per_subcase[i] += s.cells_per_subcase[i];
+    /// Pass 1 on planes [k0, k1); `largest_sample` bounds |sample| on planes k0 - 1 .. k1 + 1.
+    /// Stops early (returning partial counts) when the ticker says so.
+    RangeCounts count(std::int64_t k0, std::int64_t k1, double largest_sample, Ticker* ticker) const
+    {
+        RangeCounts c;
+        c.k0_ = k0, c.k1_ = k1, c.nx_ = nx_, c.ny_ = ny_, c.largest_sample_ = largest_sample;
+        c.rows_.assign(static_cast<std::size_t>((k1 - k0) * ny_), {});
+        Scratch s(nx_, ny_);
+        for (std::int64_t k = k0; k < k1; ++k) {
+            for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, s, c);
+            if (ticker && !ticker->tick()) return c;
+        }
+        if (k1 < nz_) {
+            // plane k1 is the next range's: its rows' x/y edge vertices come first there
+            c.seam_first_.assign(static_cast<std::size_t>(ny_) + 1, 0);
+            for (std::int64_t j = 0; j < ny_; ++j) {
+                const std::uint8_t* f = flags(j, k1, s);
+                const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k1, s) : f;
+                c.seam_first_[static_cast<std::size_t>(j) + 1] = c.seam_first_[static_cast<std::size_t>(j)] + xy_crossings(f, fy, nx_);
+            }
+        }
+        // the rows hold their counts; turn them into first ids (the numbering of passes.hpp)
+        std::int64_t v = 0, t = 0;
+        for (std::int64_t k = k0; k < k1; ++k) {
+            RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - k0) * ny_)];
+            for (std::int64_t j = 0; j < ny_; ++j) v += std::exchange(plane[j].xy_first, v);
+            for (std::int64_t j = 0; j < ny_; ++j) v += std::exchange(plane[j].z_first, v);
+            for (std::int64_t j = 0; j < ny_; ++j) t += std::exchange(plane[j].triangle_first, t);
+        }
+        c.vertices_ = v, c.triangles_ = t;
+        return c;
+    }
+
+    /// Pass 3 (see passes.hpp).
+    void emit(const RangeCounts& c, const RangeOffsets& off, const MeshSpans& out, Ticker* ticker) const
+    {
+        const std::int64_t k0 = c.k0_, k1 = c.k1_;
+        const std::int64_t seam = c.seam_first_.empty() ? 0 : c.seam_first_.back();
+        const std::int64_t next = off.first_vertex + c.vertices_;
+        if (off.first_vertex < 0 || off.first_triangle < 0 ||
+            next + seam > static_cast<std::int64_t>(kNoVertex)) {
+            throw Error(Status::too_large, "the mesh would have vertex ids up to " + std::to_string(next + seam) +
+                                               ", more than 32-bit indices can address");
+        }
+        if ((c.vertices_ > 0 && out.positions == nullptr) || (c.triangles_ > 0 && out.triangles == nullptr)) {
+            throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
+        }
+        const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
+        Scratch s(nx_, ny_);
+        for (std::int64_t k = k0; k < k1; ++k) {
+            for (std::int64_t j = 0; j < ny_; ++j) {
+                const RowSpan r = span_of(c, j, k);
+                if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
+                std::int64_t interior = 0;
+                const std::uint32_t* ids = row_ids(j, k, s, e, interior);
+                emit_row_vertices(j, k, ids, e);
+                std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
+                if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end);
+                if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
+                    throw_mismatch("vertices or triangles", j, k);
                 }
+            }
+            if (ticker && !ticker->tick()) return;
         }
-
-        // Pass 2: exclusive scan (row r's counts are stored at r + 1).
-        for (std::int64_t r = 0; r < rows; ++r) {
-            row_vertices_[static_cast<std::size_t>(r) + 1] += row_vertices_[static_cast<std::size_t>(r)];
-            row_triangles_[static_cast<std::size_t>(r) + 1] += row_triangles_[static_cast<std::size_t>(r)];
-        }
-        const std::int64_t nv = row_vertices_.back(), nt = row_triangles_.back();
-        if (nv >= static_cast<std::int64_t>(kNoVertex)) {
-            throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
-                                               " vertices, more than 32-bit indices can address");
-        }
-        Mesh mesh;
-        mesh.positions.resize(static_cast<std::size_t>(nv) * 3);
-        if (opt_.normals) mesh.normals.resize(static_cast<std::size_t>(nv) * 3);
-        mesh.triangles.resize(static_cast<std::size_t>(nt) * 3);
-
-        // Passes 3 and 4: emit.
-        detail::parallel_chunks(nz_, threads_, [&](int, std::int64_t k0, std::int64_t k1) {
-            Scratch scratch(nx_, ny_);
-            for (std::int64_t k = k0; k < k1; ++k)
-                for (std::int64_t j = 0; j < ny_; ++j) {
-                    const auto r = static_cast<std::size_t>(row_index(j, k));
-                    std::int64_t interior_start = row_vertices_[r];
-                    if (row_vertices_[r + 1] != row_vertices_[r]) {
-                        emit_row_vertices(j, k, row_ids(j, k, scratch, interior_start), mesh);
-                    }
-                    if (j + 1 < ny_ && k + 1 < nz_ && row_triangles_[r + 1] != row_triangles_[r]) {
-                        emit_row_cells(j, k, scratch, interior_start, mesh);
-                    }
-                }
-        });
-        return mesh;
     }
 
 private:
+    /// emit() found other numbers than count() in row (j, k): the samples, the isovalue or the
+    /// method changed between the passes, or a bug in cmc33. Thrown before writing outside the
+    /// row's part of the output.
+    [[noreturn]] static void throw_mismatch(const char* what, std::int64_t j, std::int64_t k)
+    {
+        throw Error(Status::internal, std::string("emit found other ") + what + " in sample row (" + std::to_string(j) +
+                                          ", " + std::to_string(k) +
+                                          ") than count did: the samples, isovalue or method differ between "
+                                          "the passes, or a bug in cmc33");
+    }
+
+    /// One range's emit: its counts, offsets and output.
+    struct Emit {
+        const RangeCounts& c;
+        const RangeOffsets& off;
+        const MeshSpans& out;
+        double gradient_scale;
+    };
+
     /// One thread's working memory: above-flags of three slices, vertex ids of four sample rows,
     /// and the column codes of the current cell row. O(nx * ny) bytes.
     struct Scratch {
@@ -258,8 +406,31 @@ private:
         std::vector<std::uint8_t> columns;
     };
 
+    /// The range-relative ids of row (j, k) of a range: x/y edge vertices [xy0, xy1), z edge and
+    /// interior vertices [z0, v1), triangles [t0, t1); its trim range [lo, hi).
+    struct RowSpan {
+        std::int64_t xy0, xy1, z0, v1, t0, t1;
+        std::int64_t lo, hi;
+    };
+    RowSpan span_of(const RangeCounts& c, std::int64_t j, std::int64_t k) const
+    {
+        const std::size_t r = static_cast<std::size_t>(j + (k - c.k0_) * ny_);
+        const RangeCounts::Row& row = c.rows_[r];
+        const RangeCounts::Row& first = c.rows_[static_cast<std::size_t>((k - c.k0_) * ny_)];
+        const bool last_row = j + 1 == ny_;
+        const bool last_plane = k + 1 == c.k1_;
+        RowSpan s{};
+        s.xy0 = row.xy_first;
+        s.xy1 = last_row ? first.z_first : c.rows_[r + 1].xy_first;
+        s.z0 = row.z_first;
+        s.v1 = !last_row ? c.rows_[r + 1].z_first : last_plane ? c.vertices_ : c.rows_[r + 1].xy_first;
+        s.t0 = row.triangle_first;
+        s.t1 = !last_row ? c.rows_[r + 1].triangle_first : last_plane ? c.triangles_ : c.rows_[r + 1].triangle_first;
+        s.lo = row.lo, s.hi = row.hi;
+        return s;
+    }
+
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
-    std::int64_t row_index(std::int64_t j, std::int64_t k) const { return j + k * ny_; }
 
     /// Above-flags of the samples of row (j, k); `above` counts the samples above.
     const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& above) const
@@ -268,8 +439,8 @@ private:
         std::int64_t* count = nullptr;
         std::uint8_t* f = s.flags.get(j, k, fresh, count);
         if (fresh) {
-            above_.row(g_.data + g_.offset(0, j, k), nx_, f);
-            std::uint32_t n = 0; // nx < 2^31 (validate); a narrow sum vectorises
+            above_.row(g_.data + g_.offset(0, j, k), nx_, sx_, f);
+            std::uint32_t n = 0; // nx < 2^32 / 3 (validate); a narrow sum vectorises
             for (std::int64_t i = 0; i < nx_; ++i) n += f[i];
             *count = n;
         }
@@ -297,39 +468,54 @@ private:
     }
 
     /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
-    /// where the edge does not cross or does not exist. `interior_start`: the id after the row's
-    /// last edge vertex, where the interior vertices of its cells begin.
-    const std::uint32_t* row_ids(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& interior_start) const
+    /// where the edge does not cross or does not exist (or, in the next range's plane k1, for the z
+    /// edges, which no cell of this range uses). `interior`: the id after the row's last z edge
+    /// vertex, where the interior vertices of its cells begin.
+    const std::uint32_t* row_ids(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& interior) const
     {
         bool fresh = false;
         std::int64_t* end = nullptr;
         std::uint32_t* ids = s.ids.get(j, k, fresh, end);
-        const std::size_t r = static_cast<std::size_t>(row_index(j, k));
-        if (fresh && row_vertices_[r + 1] == row_vertices_[r]) {
-            // no crossed edge (and no interior vertex): no cell will read these ids
-            *end = row_vertices_[r];
-        } else if (fresh) {
-            const std::uint8_t* f = flags(j, k, s);
-            const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
-            const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
-            auto id = static_cast<std::uint32_t>(row_vertices_[r]);
-            // outside the range no edge crosses: those slots are never read for a vertex
-            for (std::int64_t i = range_[r][0]; i < range_[r][1]; ++i) {
-                const unsigned crossed = crossed_edges(f, fy, fz, i, nx_);
-                for (std::int64_t axis = 0; axis < 3; ++axis) {
-                    const bool c = (crossed >> axis) & 1u;
-                    ids[3 * i + axis] = c ? id : kNoVertex;
-                    id += c;
-                }
-            }
-            *end = id;
+        if (!fresh) {
+            interior = *end;
+            return ids;
         }
-        interior_start = *end;
+        const std::uint8_t* f = flags(j, k, s);
+        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+        if (k == e.c.k1_) {
+            // the next range's first plane: its x/y edge ids follow this range's last vertex
+            auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.vertices_ +
+                                                 e.c.seam_first_[static_cast<std::size_t>(j)]);
+            for (std::int64_t i = 0; i < nx_; ++i) {
+                const unsigned crossed = crossed_edges(f, fy, f, i, nx_);
+                ids[3 * i] = crossed & 1u ? xy++ : kNoVertex;
+                ids[3 * i + 1] = crossed & 2u ? xy++ : kNoVertex;
+            }
+            if (xy != e.off.first_vertex + e.c.vertices_ + e.c.seam_first_[static_cast<std::size_t>(j) + 1]) {
+                throw_mismatch("x/y edge vertices of the next range's first plane", j, k);
+            }
+            *end = interior = -1; // not this range's row: no vertex of it is written
+            return ids;
+        }
+        const RowSpan r = span_of(e.c, j, k);
+        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+        auto xy = static_cast<std::uint32_t>(e.off.first_vertex + r.xy0);
+        auto z = static_cast<std::uint32_t>(e.off.first_vertex + r.z0);
+        // outside the trim range no edge crosses: those slots are never read for a vertex
+        for (std::int64_t i = r.lo; i < r.hi; ++i) {
+            const unsigned crossed = crossed_edges(f, fy, fz, i, nx_);
+            ids[3 * i] = crossed & 1u ? xy++ : kNoVertex;
+            ids[3 * i + 1] = crossed & 2u ? xy++ : kNoVertex;
+            ids[3 * i + 2] = crossed & 4u ? z++ : kNoVertex;
+        }
+        if (xy != e.off.first_vertex + r.xy1) throw_mismatch("x/y edge vertices", j, k);
+        if (z > e.off.first_vertex + r.v1) throw_mismatch("z edge vertices", j, k);
+        *end = interior = z;
         return ids;
     }
 
     /// The tiling of crossed cell (i, j, k) with case code `code`, and its subcase. Cells with a
-    /// face or interior test are decided here, in pass 1 and again in pass 4 (the same exact
+    /// face or interior test are decided here, in count and again in emit (the same exact
     /// predicates on the same values, so the same answer): that costs less than storing a
     /// decision per cell, and leaves no per-cell working memory.
     const detail::Tiling& tiling_of(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, int& subcase) const
@@ -343,12 +529,14 @@ private:
         for (int c = 0; c < 8; ++c) {
             raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
-        const detail::Decision d = detail::decide(raw, iso_, code, opt_.method, nullptr, std::is_integral_v<T>);
+        const detail::Decision d = detail::decide(raw, iso_, code, method_, nullptr, std::is_integral_v<T>);
         subcase = d.subcase;
         return d.variant->tilings[d.tiling];
     }
 
-    void count_row(std::int64_t j, std::int64_t k, Scratch& s, ExtractStats& stats)
+    /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
+    /// vertices in z_first, triangles in triangle_first (count() turns them into first ids).
+    void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c) const
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
@@ -359,14 +547,13 @@ private:
         const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
         if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
         if ((n0 == 0 || n0 == nx_) && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
-        const auto r = static_cast<std::size_t>(row_index(j, k));
-        // crossed edges owned by the row: flags are 0 or 1, so != is ^ and the sum vectorises
-        std::uint32_t crossed = 0;
-        for (std::int64_t i = 0; i + 1 < nx_; ++i) crossed += static_cast<std::uint32_t>(f[i] ^ f[i + 1]);
-        for (std::int64_t i = 0; i < nx_; ++i) crossed += static_cast<std::uint32_t>((f[i] ^ fy[i]) + (f[i] ^ fz[i]));
-        std::int64_t vertices = crossed, triangles = 0;
+        RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
+        const std::uint32_t xy = xy_crossings(f, fy, nx_);
+        std::uint32_t z = 0;
+        for (std::int64_t i = 0; i < nx_; ++i) z += static_cast<std::uint32_t>(f[i] ^ fz[i]);
+        std::int64_t interior = 0, triangles = 0;
         std::int64_t lo = nx_, hi = 0;
-        if (crossed != 0) {
+        if (xy + z != 0) {
             lo = 0;
             while (crossed_edges(f, fy, fz, lo, nx_) == 0) ++lo;
             hi = nx_;
@@ -380,16 +567,17 @@ private:
                 if (code == 0 || code == 255) continue;
                 int subcase = 0;
                 const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
-                vertices += tl.interior_count;
+                interior += tl.interior_count;
                 triangles += tl.triangle_count;
-                ++stats.cells_per_subcase[static_cast<std::size_t>(subcase)];
+                ++c.stats_.cells_per_subcase[static_cast<std::size_t>(subcase)];
                 lo = std::min(lo, i);
                 hi = std::max(hi, i + 1);
             }
         }
-        if (hi > lo) range_[r] = {static_cast<std::int32_t>(lo), static_cast<std::int32_t>(hi)};
-        row_vertices_[r + 1] = vertices;
-        row_triangles_[r + 1] = triangles;
+        if (hi > lo) row.lo = static_cast<std::int32_t>(lo), row.hi = static_cast<std::int32_t>(hi);
+        row.xy_first = xy;
+        row.z_first = z + interior;
+        row.triangle_first = triangles;
     }
 
     /// The crossing parameter of the edge from sample value a to b, in [delta, 1 - delta]
@@ -448,6 +636,7 @@ private:
 
     /// A power of two that keeps every scaled gradient, and its interpolation between two samples,
     /// finite: 1 unless the samples or the map to world gradients are near the double range.
+    /// (Scaling by a power of two is exact, so ranges with different bounds give the same normals.)
     double gradient_scale(double largest_sample) const
     {
         double map = 0; // largest factor from an index difference to a world gradient component
@@ -467,8 +656,8 @@ private:
 
     /// The gradient at sample (i, j, k) by central differences (one-sided at the border), in world
     /// coordinates for a diagonal frame, in index coordinates otherwise (write_normal maps it),
-    /// times gradient_scale_.
-    std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k) const
+    /// times `scale`.
+    std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k, double scale) const
     {
         std::array<double, 3> grad{};
         const std::int64_t idx[3] = {i, j, k};
@@ -478,31 +667,39 @@ private:
             if (idx[axis] > 0) --lo[axis];
             if (idx[axis] + 1 < n[axis]) ++hi[axis];
             const double d = static_cast<double>(hi[axis] - lo[axis]) * step_[static_cast<std::size_t>(axis)];
-            const double s = gradient_scale_; // 1 unless differences of the samples could overflow
-            grad[static_cast<std::size_t>(axis)] =
-                (s * static_cast<double>(at(hi[0], hi[1], hi[2])) - s * static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
+            grad[static_cast<std::size_t>(axis)] = (scale * static_cast<double>(at(hi[0], hi[1], hi[2])) -
+                                                    scale * static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
         }
         return grad;
     }
 
-    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Mesh& mesh) const
+    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, const Emit& e) const
     {
-        const auto r = static_cast<std::size_t>(row_index(j, k));
-        for (std::int64_t slot = 3 * std::int64_t{range_[r][0]}; slot < 3 * std::int64_t{range_[r][1]}; ++slot) {
+        const RowSpan r = span_of(e.c, j, k);
+        const MeshSpans& out = e.out;
+        for (std::int64_t slot = 3 * r.lo; slot < 3 * r.hi; ++slot) {
             const std::uint32_t id = ids[slot];
             if (id == kNoVertex) continue;
             const std::int64_t i = slot / 3;
             const int axis = static_cast<int>(slot % 3);
             const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
-            const double t = crossing(at(i, j, k), at(end[0], end[1], end[2]));
+            const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
+            const double t = crossing(a, b);
             const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
             double x[3];
             for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
-            write_position(x, &mesh.positions[static_cast<std::size_t>(id) * 3]);
-            if (opt_.normals) {
-                const auto ga = gradient(i, j, k), gb = gradient(end[0], end[1], end[2]);
-                write_normal(&mesh.normals[static_cast<std::size_t>(id) * 3],
+            const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
+            write_position(x, &out.positions[v * 3]);
+            if (out.normals) {
+                const auto ga = gradient(i, j, k, e.gradient_scale), gb = gradient(end[0], end[1], end[2], e.gradient_scale);
+                write_normal(&out.normals[v * 3],
                              {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
+            }
+            if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
+            if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
+            if (out.vertex_values) {
+                const double va = static_cast<double>(a), vb = static_cast<double>(b);
+                out.vertex_values[v] = static_cast<float>(va + t * (vb - va));
             }
         }
     }
@@ -527,81 +724,108 @@ private:
         for (int c = 0; c < 3; ++c) out[c] = len > 0 ? static_cast<float>(-g[static_cast<std::size_t>(c)] / len) : 0.0f;
     }
 
-    void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t vertex, Mesh& mesh) const
+    /// The cells of cell row (j, k): interior vertices from id `vertex` on and triangles from id
+    /// `tri` on; both are left one past the last written.
+    void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& vertex,
+                        std::int64_t& tri) const
     {
         // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
         std::int64_t unused = 0;
-        const std::uint32_t* ids[4] = {row_ids(j, k, s, unused), row_ids(j + 1, k, s, unused),
-                                       row_ids(j, k + 1, s, unused), row_ids(j + 1, k + 1, s, unused)};
+        const std::uint32_t* ids[4] = {row_ids(j, k, s, e, unused), row_ids(j + 1, k, s, e, unused),
+                                       row_ids(j, k + 1, s, e, unused), row_ids(j + 1, k + 1, s, e, unused)};
         column_codes(j, k, s);
         const std::uint8_t* col = s.columns.data();
-        const auto r = static_cast<std::size_t>(row_index(j, k));
-        std::int64_t tri = row_triangles_[r];
-        const std::int64_t last = std::min<std::int64_t>(range_[r][1], nx_ - 1);
-        for (std::int64_t i = range_[r][0]; i < last; ++i) {
+        const RowSpan r = span_of(e.c, j, k);
+        const MeshSpans& out = e.out;
+        tri = e.off.first_triangle + r.t0;
+        const std::int64_t last = std::min<std::int64_t>(r.hi, nx_ - 1);
+        bool missing = false; // a triangle on an edge that does not cross
+        for (std::int64_t i = r.lo; i < last; ++i) {
             const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
             if (code == 0 || code == 255) continue;
             int subcase = 0;
             const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
             std::uint32_t edge_id[12];
-            for (int e = 0; e < 12; ++e) {
-                const int c = kEdgeCorners[e][0];
+            for (int q = 0; q < 12; ++q) {
+                const int c = kEdgeCorners[q][0];
                 const std::uint32_t* row = ids[kCornerOffset[c][1] + 2 * kCornerOffset[c][2]];
-                edge_id[e] = row[3 * (i + kCornerOffset[c][0]) + e / 4];
+                edge_id[q] = row[3 * (i + kCornerOffset[c][0]) + q / 4];
+            }
+            if (vertex + tl.interior_count > e.off.first_vertex + r.v1 ||
+                tri + tl.triangle_count > e.off.first_triangle + r.t1) {
+                throw_mismatch("cells", j, k); // before writing past the row's part of the output
             }
             const std::int64_t first_interior = vertex;
-            if (tl.interior_count > 0) write_interior_vertices(i, j, k, tl, vertex, mesh);
+            if (tl.interior_count > 0) write_interior_vertices(i, j, k, tl, vertex, e);
             vertex += tl.interior_count;
             const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3];
-            std::uint32_t* out = &mesh.triangles[static_cast<std::size_t>(tri) * 3];
+            const auto t0 = static_cast<std::size_t>(tri - out.first_triangle);
+            std::uint32_t* o = &out.triangles[t0 * 3];
             for (int q = 0; q < 3 * tl.triangle_count; ++q) {
                 const int v = codes[q];
-                out[q] = v < 12 ? edge_id[v] : static_cast<std::uint32_t>(first_interior + (v - 12));
+                o[q] = v < 12 ? edge_id[v] : static_cast<std::uint32_t>(first_interior + (v - 12));
+                missing |= o[q] == kNoVertex;
             }
             if (mirrored_) {
-                for (int q = 0; q < 3 * tl.triangle_count; q += 3) std::swap(out[q + 1], out[q + 2]);
+                for (int q = 0; q < 3 * tl.triangle_count; q += 3) std::swap(o[q + 1], o[q + 2]);
+            }
+            if (out.triangle_cells) {
+                const std::int64_t cell = i + nx_ * (j + ny_ * k);
+                for (int q = 0; q < tl.triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
             tri += tl.triangle_count;
         }
+        if (missing) throw_mismatch("crossed edges", j, k);
     }
 
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
     /// placement.hpp from the cell's crossings; normals interpolate the corners' gradients.
     void write_interior_vertices(std::int64_t i, std::int64_t j, std::int64_t k, const detail::Tiling& tl,
-                                 std::int64_t first, Mesh& mesh) const
+                                 std::int64_t first, const Emit& e) const
     {
+        const MeshSpans& out = e.out;
         T value[8];
         for (int c = 0; c < 8; ++c) value[c] = at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
         double crossing_at[12][3] = {};
         unsigned needed = 0;
         for (int q = 0; q < tl.interior_count; ++q) {
             const unsigned code = detail::kInteriorMasks[tl.first_interior + q];
-            for (int e = 0; e < 12; ++e) needed |= static_cast<unsigned>(detail::interior_uses_edge(code, e)) << e;
+            for (int edge = 0; edge < 12; ++edge) needed |= static_cast<unsigned>(detail::interior_uses_edge(code, edge)) << edge;
         }
-        for (int e = 0; e < 12; ++e) {
-            if (!((needed >> e) & 1u)) continue;
-            const int a = kEdgeCorners[e][0], b = kEdgeCorners[e][1];
+        for (int edge = 0; edge < 12; ++edge) {
+            if (!((needed >> edge) & 1u)) continue;
+            const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
             const double t = crossing(value[a], value[b]);
-            for (int c = 0; c < 3; ++c) crossing_at[e][c] = static_cast<double>(kCornerOffset[a][c]) + (c == e / 4 ? t : 0.0);
+            for (int c = 0; c < 3; ++c)
+                crossing_at[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
         }
         std::array<double, 3> grad[8];
-        if (opt_.normals) {
-            for (int c = 0; c < 8; ++c) grad[c] = gradient(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
+        if (out.normals) {
+            for (int c = 0; c < 8; ++c) {
+                grad[c] = gradient(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2], e.gradient_scale);
+            }
         }
         const double base[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
         for (int q = 0; q < tl.interior_count; ++q) {
             double p[3];
             detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
-            const auto id = static_cast<std::size_t>(first + q);
+            const auto v = static_cast<std::size_t>(first + q - out.first_vertex);
             const double x[3] = {base[0] + p[0], base[1] + p[1], base[2] + p[2]};
-            write_position(x, &mesh.positions[id * 3]);
-            if (opt_.normals) {
-                double w[8];
-                detail::trilinear_weights(p, w);
+            write_position(x, &out.positions[v * 3]);
+            double w[8];
+            if (out.normals || out.vertex_values) detail::trilinear_weights(p, w);
+            if (out.normals) {
                 std::array<double, 3> n{};
                 for (int c = 0; c < 8; ++c)
                     for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
-                write_normal(&mesh.normals[id * 3], n);
+                write_normal(&out.normals[v * 3], n);
+            }
+            if (out.vertex_edges) out.vertex_edges[v] = -1 - (i + nx_ * (j + ny_ * k));
+            if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
+            if (out.vertex_values) {
+                double f = 0;
+                for (int c = 0; c < 8; ++c) f += w[c] * static_cast<double>(value[c]);
+                out.vertex_values[v] = static_cast<float>(f);
             }
         }
     }
@@ -609,24 +833,20 @@ private:
     const GridView<T>& g_;
     double iso_;
     Above<T> above_;
-    ExtractOptions opt_;
-    std::int64_t nx_, ny_, nz_;
-    int threads_;
+    Method method_;
+    std::int64_t nx_, ny_, nz_, sx_;
     Mat3 m_;                  ///< index to world: M = D * diag(spacing)
     bool diagonal_, mirrored_; ///< M diagonal; det M < 0 (triangles are reversed)
     double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
-    double gradient_scale_ = 1;
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
     std::array<bool, 256> needs_values_{};
-    std::vector<std::int64_t> row_vertices_, row_triangles_;
-    /// Trim range from pass 1, per row r: [range_[r][0], range_[r][1]) holds every sample of row r
-    /// that owns a crossed edge and every crossed cell of cell row r (nx < 2^31: validate()).
-    std::vector<std::array<std::int32_t, 2>> range_;
 };
 
-/// Checks the grid and isovalue; returns the largest |sample| (a bound for integer types).
-template <class T> double validate(const GridView<T>& g, double iso)
+namespace {
+
+/// Checks the grid and isovalue: everything but the samples.
+template <class T> void check_grid(const GridView<T>& g, double iso)
 {
     if (!std::isfinite(iso)) {
         throw Error(Status::non_finite, "isovalue " + std::to_string(iso) + " is not a finite number");
@@ -638,7 +858,7 @@ template <class T> double validate(const GridView<T>& g, double iso)
                                                       "; an isosurface needs at least 2 on each axis");
         }
     }
-    if (g.strides[0] != 1) throw Error(Status::invalid_argument, "grid view must have unit x-stride");
+    if (g.data == nullptr) throw Error(Status::invalid_argument, "grid view has no samples (a null data pointer)");
     const Mat3 m = frame_matrix(g.spacing, g.direction);
     for (std::size_t r = 0; r < 3; ++r) {
         const bool finite = std::isfinite(g.origin[r]) && std::isfinite(m[r][0]) && std::isfinite(m[r][1]) &&
@@ -664,35 +884,128 @@ template <class T> double validate(const GridView<T>& g, double iso)
         throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) + " samples along x; the extractor handles at most " +
                                            std::to_string(kMaxRow) + " per row");
     }
-    double largest_sample = 0;
+}
+
+/// The largest |sample| of planes [k_lo, k_hi] (for integer types, the type's bound).
+/// @throws Error{non_finite} for NaN or infinite samples there, saying how many and the first
+template <class T> double largest_sample(const GridView<T>& g, std::int64_t k_lo, std::int64_t k_hi)
+{
     if constexpr (std::is_floating_point_v<T>) {
+        double largest = 0;
         std::int64_t count = 0;
         Index3 first{-1, -1, -1};
-        for (std::int64_t k = 0; k < g.nz(); ++k)
+        for (std::int64_t k = k_lo; k <= k_hi; ++k)
             for (std::int64_t j = 0; j < g.ny(); ++j)
                 for (std::int64_t i = 0; i < g.nx(); ++i) {
                     const double v = std::fabs(static_cast<double>(g(i, j, k)));
                     if (!std::isfinite(v) && count++ == 0) first = {i, j, k};
-                    largest_sample = std::max(largest_sample, v);
+                    largest = std::max(largest, v);
                 }
         if (count > 0) {
             throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
                                                 std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
                                                 std::to_string(first[2]) + "); cmc33 needs finite samples");
         }
+        return largest;
     } else {
-        largest_sample = std::max(std::fabs(static_cast<double>(std::numeric_limits<T>::lowest())),
-                                  static_cast<double>(std::numeric_limits<T>::max()));
+        return std::max(std::fabs(static_cast<double>(std::numeric_limits<T>::lowest())),
+                        static_cast<double>(std::numeric_limits<T>::max()));
     }
-    return largest_sample;
+}
+
+std::string range_text(std::int64_t k0, std::int64_t k1)
+{
+    return "[" + std::to_string(k0) + ", " + std::to_string(k1) + ")";
 }
 
 } // namespace
 
+template <class T>
+RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1)
+{
+    check_grid(grid, iso);
+    if (!(0 <= k0 && k0 < k1 && k1 <= grid.nz())) {
+        throw Error(Status::invalid_argument, "count: sample planes " + range_text(k0, k1) + "; expected 0 <= k0 < k1 <= " +
+                                                  std::to_string(grid.nz()) + " (the grid's nz)");
+    }
+    const double largest = largest_sample(grid, std::max<std::int64_t>(k0 - 1, 0), std::min(k1 + 1, grid.nz() - 1));
+    return RangeExtractor<T>(grid, iso, options).count(k0, k1, largest, nullptr);
+}
+
+std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex, std::int64_t first_triangle)
+{
+    std::vector<RangeOffsets> offsets;
+    offsets.reserve(ranges.size());
+    for (std::size_t r = 0; r < ranges.size(); ++r) {
+        if (r > 0 && ranges[r].k0() != ranges[r - 1].k1()) {
+            throw Error(Status::invalid_argument, "scan: range " + std::to_string(r) + " starts at plane " +
+                                                      std::to_string(ranges[r].k0()) + "; expected " +
+                                                      std::to_string(ranges[r - 1].k1()) +
+                                                      ", where the range before it ends");
+        }
+        offsets.push_back({first_vertex, first_triangle});
+        first_vertex += ranges[r].vertex_count();
+        first_triangle += ranges[r].triangle_count();
+    }
+    return offsets;
+}
+
+template <class T>
+void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
+          const RangeOffsets& offsets, const MeshSpans& out)
+{
+    check_grid(grid, iso);
+    if (counts.k1() > grid.nz() || counts.k0() >= counts.k1() || !RangeExtractor<T>::same_rows(counts, grid)) {
+        throw Error(Status::invalid_argument, "emit: the counts of planes " + range_text(counts.k0(), counts.k1()) +
+                                                  " are not of this grid (" + std::to_string(grid.nx()) + "x" +
+                                                  std::to_string(grid.ny()) + "x" + std::to_string(grid.nz()) +
+                                                  "); expected counts from count() on the same grid");
+    }
+    RangeExtractor<T>(grid, iso, options).emit(counts, offsets, out, nullptr);
+}
+
 template <class T> Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
 {
-    const double largest_sample = validate(grid, iso);
-    return Extractor<T>(grid, iso, options, largest_sample).run(stats);
+    check_grid(grid, iso);
+    const std::int64_t nz = grid.nz();
+    const double largest = largest_sample(grid, 0, nz - 1);
+    const RangeExtractor<T> extractor(grid, iso, options);
+    const int n = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, nz));
+    Ticker ticker(options.progress, 2 * nz);
+
+    std::vector<RangeCounts> counts(static_cast<std::size_t>(n));
+    run_tasks(n, options.executor, [&](int t) {
+        counts[static_cast<std::size_t>(t)] = extractor.count(nz * t / n, nz * (t + 1) / n, largest, &ticker);
+    });
+    if (ticker.cancelled()) throw_cancelled();
+    const std::vector<RangeOffsets> offsets = scan(counts);
+    const std::int64_t nv = offsets.back().first_vertex + counts.back().vertex_count();
+    const std::int64_t nt = offsets.back().first_triangle + counts.back().triangle_count();
+    if (nv >= static_cast<std::int64_t>(kNoVertex)) {
+        throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
+                                           " vertices, more than 32-bit indices can address");
+    }
+    Mesh mesh;
+    mesh.positions.resize(static_cast<std::size_t>(nv) * 3);
+    if (options.normals) mesh.normals.resize(static_cast<std::size_t>(nv) * 3);
+    mesh.triangles.resize(static_cast<std::size_t>(nt) * 3);
+    MeshSpans out;
+    out.positions = mesh.positions.data();
+    out.triangles = mesh.triangles.data();
+    out.normals = options.normals ? mesh.normals.data() : nullptr;
+    run_tasks(n, options.executor, [&](int t) {
+        extractor.emit(counts[static_cast<std::size_t>(t)], offsets[static_cast<std::size_t>(t)], out, &ticker);
+    });
+    if (ticker.cancelled()) throw_cancelled();
+    ticker.finish();
+    if (stats) {
+        *stats = {};
+        for (const RangeCounts& c : counts)
+            for (std::size_t i = 0; i < static_cast<std::size_t>(kSubcaseCount); ++i) {
+                stats->cells_per_subcase[i] += c.stats().cells_per_subcase[i];
+            }
+    }
+    return mesh;
 }
 
 Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, ExtractStats* stats)
@@ -700,8 +1013,11 @@ Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, Ex
     return volume.visit([&](auto view) { return extract(view, iso, options, stats); });
 }
 
-#define CMC33_INSTANTIATE(T) \
-    template Mesh extract<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);
+#define CMC33_INSTANTIATE(T)                                                                                    \
+    template Mesh extract<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);                       \
+    template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
+    template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
+                          const MeshSpans&);
 CMC33_INSTANTIATE(std::int8_t)
 CMC33_INSTANTIATE(std::uint8_t)
 CMC33_INSTANTIATE(std::int16_t)

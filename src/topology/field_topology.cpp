@@ -347,7 +347,7 @@ std::string format_dims(const Index3& d)
     return std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]);
 }
 
-void check_arguments(bool null_data, const Index3& dims, const Index3& strides, double iso)
+void check_arguments(bool null_data, const Index3& dims, double iso)
 {
     if (dims[0] < 2 || dims[1] < 2 || dims[2] < 2) {
         throw Error(Status::invalid_argument, "field_topology: grid of " + format_dims(dims) +
@@ -356,10 +356,6 @@ void check_arguments(bool null_data, const Index3& dims, const Index3& strides, 
     if (null_data) {
         throw Error(Status::invalid_argument,
                     "field_topology: grid has no data pointer; expected samples");
-    }
-    if (strides[0] != 1) {
-        throw Error(Status::invalid_argument,
-                    "field_topology: x-stride is " + std::to_string(strides[0]) + "; expected 1");
     }
     if (!std::isfinite(iso)) {
         throw Error(Status::non_finite,
@@ -374,9 +370,8 @@ template <class T> void check_finite(const GridView<T>& grid)
         Index3 first{-1, -1, -1};
         for (std::int64_t k = 0; k < grid.nz(); ++k) {
             for (std::int64_t j = 0; j < grid.ny(); ++j) {
-                const T* row = grid.data + grid.offset(0, j, k);
                 for (std::int64_t i = 0; i < grid.nx(); ++i) {
-                    if (!std::isfinite(row[i]) && count++ == 0) first = {i, j, k};
+                    if (!std::isfinite(grid(i, j, k)) && count++ == 0) first = {i, j, k};
                 }
             }
         }
@@ -397,10 +392,11 @@ template <class T> FieldTopology field_topology(const GridView<T>& grid, double 
                                                 const FieldTopologyOptions& options)
 {
     using namespace topology::detail;
-    check_arguments(grid.data == nullptr, grid.dims, grid.strides, iso);
+    check_arguments(grid.data == nullptr, grid.dims, iso);
     check_finite(grid);
 
     Assembler assembler(grid.dims, options.max_refinement);
+    const std::int64_t sx = grid.strides[0]; // any stride: a view of a larger or reordered array
     for (std::int64_t k = 0; k + 1 < grid.nz(); ++k) {
         assembler.begin_slab(k);
         for (std::int64_t j = 0; j + 1 < grid.ny(); ++j) {
@@ -411,14 +407,14 @@ template <class T> FieldTopology field_topology(const GridView<T>& grid, double 
             for (std::int64_t i = 0; i + 1 < grid.nx(); ++i) {
                 CellInput in;
                 in.iso = iso;
-                in.v[0] = static_cast<double>(r0[i]);
-                in.v[1] = static_cast<double>(r0[i + 1]);
-                in.v[2] = static_cast<double>(r1[i]);
-                in.v[3] = static_cast<double>(r1[i + 1]);
-                in.v[4] = static_cast<double>(r2[i]);
-                in.v[5] = static_cast<double>(r2[i + 1]);
-                in.v[6] = static_cast<double>(r3[i]);
-                in.v[7] = static_cast<double>(r3[i + 1]);
+                in.v[0] = static_cast<double>(r0[i * sx]);
+                in.v[1] = static_cast<double>(r0[(i + 1) * sx]);
+                in.v[2] = static_cast<double>(r1[i * sx]);
+                in.v[3] = static_cast<double>(r1[(i + 1) * sx]);
+                in.v[4] = static_cast<double>(r2[i * sx]);
+                in.v[5] = static_cast<double>(r2[(i + 1) * sx]);
+                in.v[6] = static_cast<double>(r3[i * sx]);
+                in.v[7] = static_cast<double>(r3[(i + 1) * sx]);
                 const unsigned code = cell_code(in);
                 if (code == 0 || code == 255) continue;
                 if (!assembler.add_cell(in, code, i, j, k)) {

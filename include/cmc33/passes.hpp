@@ -1,0 +1,119 @@
+#pragma once
+/// @file passes.hpp
+/// extract() as three public passes over ranges of sample planes, for callers that own the output
+/// memory (a numpy array, a vtkPoints, a memory-mapped file), split the volume into pieces (MPI
+/// ranks, out-of-core slabs) or run their own threads:
+///
+///     count(grid, iso, options, k0, k1)  -> RangeCounts   what range [k0, k1) will write
+///     scan(counts, first ids)            -> RangeOffsets  where each range writes
+///     emit(grid, iso, options, counts, offsets, spans)    writes it
+///
+/// **Ownership.** A range [k0, k1) of sample planes (0 <= k0 < k1 <= nz) owns every grid edge whose
+/// lower end lies in a plane k0 <= k < k1 (the x and y edges of those planes, and the z edges from
+/// plane k to k + 1) and every cell whose lowest corner does. Plane k1 is shared with the next
+/// range: its edges and their vertices belong to that range; the triangles of this range's last
+/// slab of cells (k1 - 1) use them. Ranges that cover [0, nz) without overlap therefore produce
+/// every vertex and triangle of extract() exactly once.
+///
+/// **Numbering.** Vertex ids run plane by plane: in plane k, first the vertices of the x and y
+/// edges of every sample row (rows by j, samples by i, x before y), then per row the vertices of
+/// the z edges followed by the interior vertices of the row's cells. Triangles run cell row by cell
+/// row, cells by i. So the ids of plane k1's x and y edges, which this range's last triangles use,
+/// depend only on the samples of plane k1 and on the next range's first vertex id: consecutive
+/// ranges must have consecutive ids (scan() gives them), i.e. the next range starts at
+/// offsets.first_vertex + counts.vertex_count().
+///
+/// The composition over any split, with any offsets, gives the same bytes as extract() shifted by
+/// the offsets (tests/core/test_passes.cpp); count and emit read the same samples, and emit checks
+/// that it wrote exactly what count counted (Error{internal} otherwise).
+
+#include <cstdint>
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33 {
+
+/// What count() found in one range: the number of vertices and triangles, and per sample row the
+/// numbers emit() needs to place them. Opaque apart from the accessors; O(ny * (k1 - k0)) memory.
+class RangeCounts {
+public:
+    std::int64_t k0() const noexcept { return k0_; }
+    std::int64_t k1() const noexcept { return k1_; }
+    std::int64_t vertex_count() const noexcept { return vertices_; }
+    std::int64_t triangle_count() const noexcept { return triangles_; }
+    /// Crossed cells of the range per subcase (see subcase_name()).
+    const ExtractStats& stats() const noexcept { return stats_; }
+
+private:
+    template <class T> friend class RangeExtractor;
+    struct Row {
+        std::int64_t xy_first = 0;  ///< first id of the row's x/y edge vertices (range-relative)
+        std::int64_t z_first = 0;   ///< first id of its z edge vertices, then its cells' interior ones
+        std::int64_t triangle_first = 0;
+        std::int32_t lo = 0, hi = 0; ///< samples [lo, hi) own every crossed edge and cell of the row
+    };
+    std::int64_t k0_ = 0, k1_ = 0, nx_ = 0, ny_ = 0;
+    std::int64_t vertices_ = 0, triangles_ = 0;
+    double largest_sample_ = 0;            ///< bound on |sample| near the range (normals' scaling)
+    std::vector<Row> rows_;                ///< (k1 - k0) * ny rows, row (j, k) at j + (k - k0) * ny
+    std::vector<std::int64_t> seam_first_; ///< plane k1's rows: first x/y edge vertex (next range's ids)
+    ExtractStats stats_{};
+};
+
+/// Where a range's vertices and triangles go in the caller's numbering.
+struct RangeOffsets {
+    std::int64_t first_vertex = 0;
+    std::int64_t first_triangle = 0;
+};
+
+/// Output memory the caller owns. Element 0 of the vertex arrays holds vertex `first_vertex` of the
+/// global numbering and element 0 of the triangle arrays triangle `first_triangle`, so a range (or
+/// an MPI rank) can be given just its slice of a larger output; emit() writes the ids in
+/// [offsets.first_vertex, + counts.vertex_count()) and the triangles in
+/// [offsets.first_triangle, + counts.triangle_count()). Null arrays are not written.
+struct MeshSpans {
+    float* positions = nullptr;          ///< 3 per vertex, world coordinates (required)
+    std::uint32_t* triangles = nullptr;  ///< 3 per triangle, global vertex ids (required)
+    float* normals = nullptr;            ///< 3 per vertex, unit; computed only when not null
+    /// Per vertex, for interpolating other point data (a VTK filter's needs): the grid edge of an
+    /// edge vertex, 3 * (i + nx * (j + ny * k)) + axis for the edge from sample (i, j, k) along axis;
+    /// for an interior vertex -1 - c, c = i + nx * (j + ny * k) the lowest corner of its cell.
+    std::int64_t* vertex_edges = nullptr;
+    /// Per vertex: an edge vertex's parameter t in (0, 1) along its edge, from the edge's lower
+    /// sample (value a) to its upper one (b); -1 for an interior vertex.
+    float* vertex_parameters = nullptr;
+    /// Per vertex: the trilinear interpolant of the samples at the vertex (close to iso: crossings
+    /// are kept delta away from samples, docs/conventions.md "Geometry").
+    float* vertex_values = nullptr;
+    /// Per triangle: the cell it lies in, i + nx * (j + ny * k) of the cell's lowest corner.
+    std::int64_t* triangle_cells = nullptr;
+    std::int64_t first_vertex = 0;   ///< global id of element 0 of the vertex arrays
+    std::int64_t first_triangle = 0; ///< global id of element 0 of the triangle arrays
+};
+
+/// Pass 1 on sample planes [k0, k1): classifies and decides every cell the range owns and counts
+/// its vertices and triangles. Reads sample planes k0 .. min(k1, nz - 1). Single-threaded: run
+/// ranges in parallel for threads (options.threads, progress and executor are not used here).
+/// @throws Error{invalid_argument} unless 0 <= k0 < k1 <= nz, or for the grid errors of extract()
+template <class T>
+RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1);
+
+/// Pass 2: consecutive offsets for ranges in order, starting at the given ids.
+std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex = 0,
+                               std::int64_t first_triangle = 0);
+
+/// Pass 3: writes the range's vertices (positions, and normals etc. where `out` has arrays for them)
+/// and triangles into `out`. `counts` must come from count() on the same grid, iso and method.
+/// Reads planes k0 - 1 .. min(k1 + 1, nz - 1) (the outer two only for normals' central
+/// differences). Single-threaded (options.threads, progress and executor are not used here).
+/// @throws Error{internal} if the cells decided differently than in count() (a bug); Error{too_large}
+///         if a vertex id passes 2^32 - 2
+template <class T>
+void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
+          const RangeOffsets& offsets, const MeshSpans& out);
+
+} // namespace cmc33

@@ -1,0 +1,378 @@
+// The public passes of passes.hpp: any split of the sample planes into ranges, with any first ids
+// and each range writing only its slice of caller-owned arrays, gives extract()'s mesh byte for
+// byte; the per-vertex and per-triangle extras say where each element came from; progress,
+// cancellation and the caller's executor; views with any strides; misuse refused.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <random>
+#include <span>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/passes.hpp"
+#include "cmc33/topology.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using cmc33::ExtractOptions;
+using cmc33::GridView;
+using cmc33::Method;
+using cmc33::MeshSpans;
+using cmc33::RangeCounts;
+using cmc33::RangeOffsets;
+using cmc33::Volume;
+
+Volume bucky()
+{
+    return cmc33::io::read_volume(std::filesystem::path(CMC33_SOURCE_DIR) / "data" / "Bucky_32x32x32_uint8.nrrd");
+}
+
+Volume noise(cmc33::Index3 dims, std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    return cmc33::test::make_volume(dims, [&](auto, auto, auto) { return u(rng); });
+}
+
+/// The output of a split run: arrays for the global ids [first_vertex, first_vertex + n).
+struct Output {
+    std::int64_t first_vertex = 0, first_triangle = 0;
+    std::vector<float> positions, normals, parameters, values;
+    std::vector<std::uint32_t> triangles;
+    std::vector<std::int64_t> edges, cells;
+};
+
+/// count / scan / emit over the ranges [b[r], b[r + 1]), each range given only its slice of the
+/// output (element 0 of its arrays is its own first vertex and triangle).
+template <class T>
+Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, const std::vector<std::int64_t>& b,
+                 std::int64_t first_vertex = 0, std::int64_t first_triangle = 0)
+{
+    std::vector<RangeCounts> counts;
+    for (std::size_t r = 0; r + 1 < b.size(); ++r) counts.push_back(cmc33::count(g, iso, opt, b[r], b[r + 1]));
+    const std::vector<RangeOffsets> offsets = cmc33::scan(counts, first_vertex, first_triangle);
+    Output o;
+    o.first_vertex = first_vertex, o.first_triangle = first_triangle;
+    std::int64_t nv = 0, nt = 0;
+    for (const RangeCounts& c : counts) nv += c.vertex_count(), nt += c.triangle_count();
+    const auto v = static_cast<std::size_t>(nv), t = static_cast<std::size_t>(nt);
+    o.positions.assign(3 * v, NAN), o.normals.assign(3 * v, NAN), o.parameters.assign(v, NAN), o.values.assign(v, NAN);
+    o.triangles.assign(3 * t, 0xdeadbeef), o.edges.assign(v, -7), o.cells.assign(t, -7);
+    for (std::size_t r = 0; r < counts.size(); ++r) {
+        const auto dv = static_cast<std::size_t>(offsets[r].first_vertex - first_vertex);
+        const auto dt = static_cast<std::size_t>(offsets[r].first_triangle - first_triangle);
+        MeshSpans s;
+        s.positions = o.positions.data() + 3 * dv;
+        s.normals = opt.normals ? o.normals.data() + 3 * dv : nullptr;
+        s.vertex_parameters = o.parameters.data() + dv;
+        s.vertex_values = o.values.data() + dv;
+        s.vertex_edges = o.edges.data() + dv;
+        s.triangles = o.triangles.data() + 3 * dt;
+        s.triangle_cells = o.cells.data() + dt;
+        s.first_vertex = offsets[r].first_vertex;
+        s.first_triangle = offsets[r].first_triangle;
+        cmc33::emit(g, iso, opt, counts[r], offsets[r], s);
+    }
+    return o;
+}
+
+void expect_same_mesh(const cmc33::Mesh& m, const Output& o, const std::string& what)
+{
+    ASSERT_EQ(m.positions.size(), o.positions.size()) << what;
+    ASSERT_EQ(m.triangles.size(), o.triangles.size()) << what;
+    EXPECT_TRUE(std::equal(m.positions.begin(), m.positions.end(), o.positions.begin())) << what;
+    if (!m.normals.empty()) {
+        EXPECT_TRUE(std::equal(m.normals.begin(), m.normals.end(), o.normals.begin())) << what;
+    }
+    bool same = true;
+    for (std::size_t i = 0; i < m.triangles.size(); ++i)
+        same = same && std::int64_t{m.triangles[i]} + o.first_vertex == std::int64_t{o.triangles[i]};
+    EXPECT_TRUE(same) << what << ": triangles differ";
+}
+
+/// Splits of nz planes: one range, three uneven ones, one plane each, and the two-range splits
+/// at every plane boundary.
+std::vector<std::vector<std::int64_t>> splits(std::int64_t nz)
+{
+    std::vector<std::vector<std::int64_t>> s = {{0, nz}, {0, 1, nz / 3 + 1, nz}};
+    std::vector<std::int64_t> each;
+    for (std::int64_t k = 0; k <= nz; ++k) each.push_back(k);
+    s.push_back(each);
+    for (std::int64_t k = 1; k < nz; ++k) s.push_back({0, k, nz});
+    return s;
+}
+
+TEST(Passes, AnySplitAndAnyFirstIdsGiveExtractsMesh)
+{
+    struct Case {
+        Volume volume;
+        double iso;
+    };
+    std::vector<Case> cases;
+    cases.push_back({bucky(), 100.5});
+    cases.push_back({bucky(), 100.0}); // ties on integer data
+    cases.push_back({noise({11, 9, 13}, 5), 0.0});
+    for (const Case& c : cases) {
+        for (const Method method : {Method::cmc33, Method::mc33_lewiner, Method::mc}) {
+            ExtractOptions opt;
+            opt.method = method;
+            opt.normals = true;
+            opt.threads = 1;
+            const cmc33::Mesh m = cmc33::extract(c.volume, c.iso, opt);
+            ASSERT_GT(m.triangle_count(), 100u);
+            for (const auto& b : splits(c.volume.dims()[2])) {
+                for (const auto& [fv, ft] : {std::pair<std::int64_t, std::int64_t>{0, 0}, {1000003, 77}}) {
+                    const std::string what = std::string(cmc33::method_name(method)) + " iso " + std::to_string(c.iso) +
+                                             " ranges " + std::to_string(b.size() - 1) + " from " + std::to_string(b[1]) +
+                                             " ids from " + std::to_string(fv);
+                    const Output o = c.volume.visit([&](auto view) { return run_split(view, c.iso, opt, b, fv, ft); });
+                    expect_same_mesh(m, o, what);
+                    if (testing::Test::HasFailure()) return;
+                }
+            }
+        }
+    }
+}
+
+TEST(Passes, ExtractWithAnyThreadCountIsTheCompositionOfThePasses)
+{
+    const Volume v = noise({20, 17, 23}, 9);
+    ExtractOptions opt;
+    opt.normals = true;
+    opt.threads = 1;
+    const cmc33::Mesh one = cmc33::extract(v, 0.1, opt);
+    for (const int threads : {2, 3, 7, 23, 64}) {
+        opt.threads = threads;
+        const cmc33::Mesh m = cmc33::extract(v, 0.1, opt);
+        EXPECT_EQ(m.positions, one.positions) << threads;
+        EXPECT_EQ(m.normals, one.normals) << threads;
+        EXPECT_EQ(m.triangles, one.triangles) << threads;
+    }
+}
+
+/// Checks the extras of a split run on g; adds its interior vertices to `interior`.
+template <class T>
+void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64_t>& splits, std::int64_t& interior)
+{
+    const Output o = run_split(g, iso, ExtractOptions{}, splits);
+    const std::int64_t nx = g.nx(), ny = g.ny();
+    const std::size_t nv = o.edges.size();
+    for (std::size_t i = 0; i < nv; ++i) {
+        const std::int64_t e = o.edges[i];
+        ASSERT_NE(e, -7) << "vertex " << i << " not written";
+        if (e < 0) {
+            ++interior;
+            EXPECT_EQ(o.parameters[i], -1.0f);
+            continue;
+        }
+        const std::int64_t axis = e % 3, s = e / 3;
+        const std::int64_t p[3] = {s % nx, s / nx % ny, s / (nx * ny)};
+        const float t = o.parameters[i];
+        ASSERT_GT(t, 0.0f) << i;
+        ASSERT_LT(t, 1.0f) << i;
+        for (int c = 0; c < 3; ++c) {
+            const double expected = static_cast<double>(p[c]) + (c == axis ? static_cast<double>(t) : 0.0);
+            EXPECT_NEAR(o.positions[3 * i + static_cast<std::size_t>(c)], expected, 1e-5) << i;
+        }
+        std::int64_t q[3] = {p[0], p[1], p[2]};
+        ++q[axis];
+        const double a = g(p[0], p[1], p[2]), b = g(q[0], q[1], q[2]);
+        ASSERT_TRUE((a >= iso) != (b >= iso)) << "vertex " << i << " on an edge that does not cross";
+        EXPECT_NEAR(o.values[i], a + static_cast<double>(t) * (b - a), 1e-3) << i;
+    }
+    // every triangle lies in its cell, and an interior vertex's cell is that of its triangles
+    for (std::size_t t = 0; t < o.cells.size(); ++t) {
+        const std::int64_t c = o.cells[t];
+        ASSERT_GE(c, 0);
+        const std::int64_t corner[3] = {c % nx, c / nx % ny, c / (nx * ny)};
+        for (int q = 0; q < 3; ++q) {
+            const std::size_t vtx = o.triangles[3 * t + static_cast<std::size_t>(q)];
+            ASSERT_LT(vtx, nv);
+            for (std::size_t a = 0; a < 3; ++a) {
+                EXPECT_GE(o.positions[3 * vtx + a], static_cast<float>(corner[a]));
+                EXPECT_LE(o.positions[3 * vtx + a], static_cast<float>(corner[a] + 1));
+            }
+            if (o.edges[vtx] < 0) {
+                EXPECT_EQ(-1 - o.edges[vtx], c);
+            }
+        }
+    }
+}
+
+TEST(Passes, TheExtrasSayWhereEveryVertexAndTriangleCameFrom)
+{
+    const Volume b = bucky(), n = noise({12, 11, 13}, 21);
+    std::int64_t interior = 0;
+    check_extras(b.view<std::uint8_t>(), 100.0, {0, 9, 20, 32}, interior); // ties
+    check_extras(n.view<double>(), 0.0, {0, 4, 5, 13}, interior);
+    EXPECT_GT(interior, 0) << "no interior vertex checked";
+}
+
+TEST(Passes, ProgressRisesToOneAndCancellingThrows)
+{
+    const Volume v = noise({64, 64, 96}, 3);
+    for (const int threads : {1, 2}) {
+        std::vector<double> seen;
+        std::mutex m;
+        ExtractOptions opt;
+        opt.threads = threads;
+        opt.progress = [&](double f) {
+            const std::lock_guard lock(m);
+            seen.push_back(f);
+            return true;
+        };
+        const cmc33::Mesh mesh = cmc33::extract(v, 0.0, opt);
+        ASSERT_GE(seen.size(), 2u) << "the first plane reports at once, the end with 1";
+        EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+        EXPECT_GE(seen.front(), 0.0);
+        EXPECT_EQ(seen.back(), 1.0);
+        opt.progress = nullptr;
+        EXPECT_EQ(cmc33::extract(v, 0.0, opt).triangles, mesh.triangles) << "progress changes nothing";
+
+        int calls = 0;
+        opt.progress = [&](double) { return ++calls < 2; };
+        try {
+            (void)cmc33::extract(v, 0.0, opt);
+            FAIL() << "not cancelled";
+        } catch (const cmc33::Error& e) {
+            EXPECT_EQ(e.status(), cmc33::Status::cancelled) << e.what();
+        }
+        EXPECT_EQ(calls, 2) << "no call after the one that stopped the work";
+    }
+}
+
+TEST(Passes, TheCallersExecutorRunsTheTasks)
+{
+    const Volume v = bucky();
+    ExtractOptions opt;
+    opt.threads = 4;
+    const cmc33::Mesh expected = cmc33::extract(v, 100.5, opt);
+    int batches = 0, tasks = 0;
+    opt.executor = [&](int n, const std::function<void(int)>& task) {
+        ++batches;
+        for (int t = n - 1; t >= 0; --t, ++tasks) task(t); // reversed: order must not matter
+    };
+    const cmc33::Mesh m = cmc33::extract(v, 100.5, opt);
+    EXPECT_EQ(batches, 2); // count, then emit
+    EXPECT_EQ(tasks, 8);
+    EXPECT_EQ(m.positions, expected.positions);
+    EXPECT_EQ(m.triangles, expected.triangles);
+    // an exception from the caller's side reaches the caller unchanged
+    opt.executor = [](int, const std::function<void(int)>&) { throw std::runtime_error("pool is shut down"); };
+    EXPECT_THROW((void)cmc33::extract(v, 100.5, opt), std::runtime_error);
+}
+
+TEST(Passes, ViewsWithAnyStridesAreReadInPlace)
+{
+    const Volume v = bucky();
+    const GridView<std::uint8_t> dense = v.view<std::uint8_t>();
+    const std::int64_t nx = dense.nx(), ny = dense.ny(), nz = dense.nz();
+    ExtractOptions opt;
+    opt.normals = true;
+    opt.threads = 2;
+    const cmc33::Mesh expected = cmc33::extract(dense, 100.0, opt);
+
+    // the same samples stored in Fortran order reversed (i slowest): strides (ny nz, nz, 1)
+    std::vector<std::uint8_t> fortran(static_cast<std::size_t>(nx * ny * nz));
+    for (std::int64_t k = 0; k < nz; ++k)
+        for (std::int64_t j = 0; j < ny; ++j)
+            for (std::int64_t i = 0; i < nx; ++i) fortran[static_cast<std::size_t>(k + nz * (j + ny * i))] = dense(i, j, k);
+    GridView<std::uint8_t> f = dense;
+    f.data = fortran.data();
+    f.strides = {ny * nz, nz, 1};
+    const cmc33::Mesh mf = cmc33::extract(f, 100.0, opt);
+    EXPECT_EQ(mf.positions, expected.positions);
+    EXPECT_EQ(mf.normals, expected.normals);
+    EXPECT_EQ(mf.triangles, expected.triangles);
+
+    // every axis stored backwards: negative strides, data at the sample (0, 0, 0) of the view
+    std::vector<std::uint8_t> backwards(fortran.size());
+    for (std::int64_t k = 0; k < nz; ++k)
+        for (std::int64_t j = 0; j < ny; ++j)
+            for (std::int64_t i = 0; i < nx; ++i)
+                backwards[static_cast<std::size_t>((nx - 1 - i) + nx * ((ny - 1 - j) + ny * (nz - 1 - k)))] = dense(i, j, k);
+    GridView<std::uint8_t> r = dense;
+    r.data = backwards.data() + (backwards.size() - 1);
+    r.strides = {-1, -nx, -nx * ny};
+    const cmc33::Mesh mr = cmc33::extract(r, 100.0, opt);
+    EXPECT_EQ(mr.positions, expected.positions);
+    EXPECT_EQ(mr.triangles, expected.triangles);
+
+    // every other sample along x and y (a numpy vol[::2, ::2, :] view) against a dense copy of it
+    GridView<std::uint8_t> sub = dense;
+    sub.dims = {nx / 2, ny / 2, nz};
+    sub.strides = {2, 2 * nx, nx * ny};
+    Volume copy(cmc33::ScalarType::u8, sub.dims);
+    for (std::int64_t k = 0; k < nz; ++k)
+        for (std::int64_t j = 0; j < sub.ny(); ++j)
+            for (std::int64_t i = 0; i < sub.nx(); ++i)
+                copy.samples<std::uint8_t>()[i + sub.nx() * (j + sub.ny() * k)] = sub(i, j, k);
+    const cmc33::Mesh ms = cmc33::extract(sub, 100.0, opt), mc = cmc33::extract(copy, 100.0, opt);
+    ASSERT_GT(ms.triangle_count(), 100u);
+    EXPECT_EQ(ms.positions, mc.positions);
+    EXPECT_EQ(ms.normals, mc.normals);
+    EXPECT_EQ(ms.triangles, mc.triangles);
+    // and through the passes, split
+    expect_same_mesh(mc, run_split(sub, 100.0, opt, {0, 5, 6, nz}), "strided split");
+}
+
+/// The status f() throws, or nullopt when it returns.
+template <class F> std::optional<cmc33::Status> status_of(F&& f)
+{
+    try {
+        f();
+    } catch (const cmc33::Error& e) {
+        return e.status();
+    }
+    return std::nullopt;
+}
+
+TEST(Passes, MisuseIsRefusedBeforeAnyWrite)
+{
+    const Volume v = bucky();
+    const GridView<std::uint8_t> g = v.view<std::uint8_t>();
+    const ExtractOptions opt;
+    using cmc33::Status;
+    for (const auto& [k0, k1] : {std::pair<std::int64_t, std::int64_t>{-1, 3}, {3, 3}, {5, 2}, {0, 33}}) {
+        EXPECT_EQ(status_of([&] { (void)cmc33::count(g, 100.5, opt, k0, k1); }), Status::invalid_argument) << k0 << " " << k1;
+    }
+    const RangeCounts a = cmc33::count(g, 100.5, opt, 0, 10), b = cmc33::count(g, 100.5, opt, 11, 32);
+    const std::vector<RangeCounts> gap = {a, b};
+    EXPECT_EQ(status_of([&] { (void)cmc33::scan(gap); }), Status::invalid_argument);
+
+    // counts of another grid
+    GridView<std::uint8_t> smaller = g;
+    smaller.dims = {32, 31, 32};
+    std::vector<float> positions(3 * static_cast<std::size_t>(a.vertex_count()) + 3, -1.0f);
+    std::vector<std::uint32_t> triangles(3 * static_cast<std::size_t>(a.triangle_count()) + 3, 7u);
+    MeshSpans out;
+    out.positions = positions.data();
+    out.triangles = triangles.data();
+    EXPECT_EQ(status_of([&] { cmc33::emit(smaller, 100.5, opt, a, {}, out); }), Status::invalid_argument);
+    MeshSpans none;
+    EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, opt, a, {}, none); }), Status::invalid_argument);
+
+    // counts of another isovalue: refused, and nothing written past the range's arrays (the
+    // guard element at the end of each)
+    for (const double other : {90.5, 100.0, 140.5}) {
+        EXPECT_EQ(status_of([&] { cmc33::emit(g, other, opt, a, {}, out); }), Status::internal) << other;
+        EXPECT_EQ(positions.back(), -1.0f) << other;
+        EXPECT_EQ(triangles.back(), 7u) << other;
+    }
+    cmc33::emit(g, 100.5, opt, a, {}, out); // the right counts: fine
+    RangeOffsets huge;
+    huge.first_vertex = 4294967000;
+    EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, opt, a, huge, out); }), Status::too_large);
+}
+
+} // namespace
