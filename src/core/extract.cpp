@@ -115,29 +115,31 @@ constexpr std::array<std::uint8_t, 256> kCellCode = [] {
 
 /// Above-flags of sample rows, filled row by row on demand, for three consecutive slices at once
 /// (slice k lives in buffer k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at most.
-/// Each row is computed once per thread; `count` holds its number of samples above.
+/// Each row is computed once per thread, with its kind: kBelow or kAbove when every sample of it
+/// is, else kMixed.
 class SliceFlags {
 public:
     SliceFlags(std::int64_t nx, std::int64_t ny)
         : nx_(nx), ny_(ny), flags_(static_cast<std::size_t>(3 * nx * ny)),
-          slice_of_(static_cast<std::size_t>(3 * ny), -1), count_(static_cast<std::size_t>(3 * ny), 0)
+          slice_of_(static_cast<std::size_t>(3 * ny), -1), kind_(static_cast<std::size_t>(3 * ny), 0)
     {
     }
-    /// The flags of row (j, k); `fresh` when they must be computed (then also set `count`).
-    std::uint8_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& count)
+    /// The flags of row (j, k); `fresh` when they must be computed (then also set `kind`).
+    std::uint8_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::uint8_t*& kind)
     {
         const auto row = static_cast<std::size_t>((k % 3) * ny_ + j);
         fresh = slice_of_[row] != k;
         slice_of_[row] = k;
-        count = &count_[row];
+        kind = &kind_[row];
         return &flags_[row * static_cast<std::size_t>(nx_)];
     }
+    static constexpr std::uint8_t kBelow = 0, kAbove = 1, kMixed = 2;
 
 private:
     std::int64_t nx_, ny_;
     std::vector<std::uint8_t> flags_;
     std::vector<std::int64_t> slice_of_;
-    std::vector<std::int64_t> count_;
+    std::vector<std::uint8_t> kind_;
 };
 
 /// Vertex ids of the edges owned by four sample rows, one slot per parity of (j, k): a cell row
@@ -366,7 +368,7 @@ public:
                 if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
                 std::int64_t interior = 0;
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
-                emit_row_vertices(j, k, ids, e);
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices(j, k, ids, e); // else row_ids left them stale
                 std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
                 if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end);
                 if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
@@ -432,24 +434,25 @@ private:
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
 
-    /// Above-flags of the samples of row (j, k); `above` counts the samples above.
-    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::int64_t& above) const
+    /// Above-flags of the samples of row (j, k), and the row's kind (SliceFlags).
+    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
     {
         bool fresh = false;
-        std::int64_t* count = nullptr;
-        std::uint8_t* f = s.flags.get(j, k, fresh, count);
+        std::uint8_t* known = nullptr;
+        std::uint8_t* f = s.flags.get(j, k, fresh, known);
         if (fresh) {
             above_.row(g_.data + g_.offset(0, j, k), nx_, sx_, f);
-            std::uint32_t n = 0; // nx < 2^32 / 3 (validate); a narrow sum vectorises
-            for (std::int64_t i = 0; i < nx_; ++i) n += f[i];
-            *count = n;
+            std::uint8_t any = 0, all = 1; // byte reductions: they vectorise to one op per 16 samples
+            const std::int64_t n = nx_;
+            for (std::int64_t i = 0; i < n; ++i) any |= f[i], all &= f[i];
+            *known = all ? SliceFlags::kAbove : any ? SliceFlags::kMixed : SliceFlags::kBelow;
         }
-        above = *count;
+        kind = *known;
         return f;
     }
     const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s) const
     {
-        std::int64_t unused = 0;
+        std::uint8_t unused = 0;
         return flags(j, k, s, unused);
     }
 
@@ -480,12 +483,14 @@ private:
             interior = *end;
             return ids;
         }
-        const std::uint8_t* f = flags(j, k, s);
-        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         if (k == e.c.k1_) {
             // the next range's first plane: its x/y edge ids follow this range's last vertex
-            auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.vertices_ +
-                                                 e.c.seam_first_[static_cast<std::size_t>(j)]);
+            *end = interior = -1; // not this range's row: no vertex of it is written
+            const std::int64_t seam0 = e.c.seam_first_[static_cast<std::size_t>(j)];
+            if (seam0 == e.c.seam_first_[static_cast<std::size_t>(j) + 1]) return ids; // nothing crosses: never read
+            const std::uint8_t* f = flags(j, k, s);
+            const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+            auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.vertices_ + seam0);
             for (std::int64_t i = 0; i < nx_; ++i) {
                 const unsigned crossed = crossed_edges(f, fy, f, i, nx_);
                 ids[3 * i] = crossed & 1u ? xy++ : kNoVertex;
@@ -494,10 +499,16 @@ private:
             if (xy != e.off.first_vertex + e.c.vertices_ + e.c.seam_first_[static_cast<std::size_t>(j) + 1]) {
                 throw_mismatch("x/y edge vertices of the next range's first plane", j, k);
             }
-            *end = interior = -1; // not this range's row: no vertex of it is written
             return ids;
         }
         const RowSpan r = span_of(e.c, j, k);
+        if (r.xy0 == r.xy1 && r.z0 == r.v1) {
+            // no vertex: no crossed edge, so no cell reads these slots (and no flags are needed)
+            *end = interior = e.off.first_vertex + r.z0;
+            return ids;
+        }
+        const std::uint8_t* f = flags(j, k, s);
+        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
         auto xy = static_cast<std::uint32_t>(e.off.first_vertex + r.xy0);
         auto z = static_cast<std::uint32_t>(e.off.first_vertex + r.z0);
@@ -540,13 +551,13 @@ private:
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
-        std::int64_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
+        std::uint8_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
         const std::uint8_t* f = flags(j, k, s, n0);
         n1 = n2 = n3 = n0;
         const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s, n1) : f;
         const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
         if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
-        if ((n0 == 0 || n0 == nx_) && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
+        if (n0 != SliceFlags::kMixed && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
         RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
         const std::uint32_t xy = xy_crossings(f, fy, nx_);
         std::uint32_t z = 0;
