@@ -19,6 +19,7 @@ struct DatasetArgs {
     std::string output;
     DatasetOptions options;
     bool progress = false;
+    bool quiet = false;
 };
 
 void run_dataset(const DatasetArgs& args)
@@ -32,7 +33,7 @@ void run_dataset(const DatasetArgs& args)
         throw UsageError("nothing to write: --cells, --grids, --closed and --ties are all 0");
     }
     DatasetOptions options = args.options;
-    options.progress = progress_line(args.progress, "fields");
+    options.progress = progress_line(args.progress, args.quiet, "fields");
     DatasetSummary s;
     try {
         s = write_dataset(args.output, options);
@@ -90,8 +91,9 @@ void add_dataset(CLI::App& app)
                     "Worker threads, 0 = all cores (default 0, at most 1024)")
         ->type_name("N")
         ->check(thread_count());
-    cmd->add_flag("--progress", args->progress,
-                  "Progress lines on stderr even when it is not a terminal");
+    auto* progress = cmd->add_flag("--progress", args->progress,
+                                   "Progress lines on stderr even when it is not a terminal");
+    cmd->add_flag("--quiet", args->quiet, "No progress lines (shown on a terminal by default)")->excludes(progress);
     cmd->footer(
         "Writes OUT/cells/cell-000001.nrrd ..., OUT/grids/..., OUT/closed/..., OUT/ties/... (float NRRD), and\n"
         "OUT/manifest.tsv: one line per file with the isovalue and the Euler characteristic, "

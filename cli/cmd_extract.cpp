@@ -30,6 +30,8 @@ struct ExtractArgs {
     bool ascii = false;
     int repeat = 1;
     bool no_topology = false;
+    bool progress = false;
+    bool quiet = false;
     RawVolumeOptions raw;
 };
 
@@ -58,7 +60,15 @@ void run_extract(const ExtractArgs& args)
         mesh = Mesh{}; // free the previous run's mesh before the next one allocates
         stats = ExtractStats{};
         const auto start = std::chrono::steady_clock::now();
-        mesh = named_step(args.input, "extracting the mesh", [&] { return extract(volume, args.iso, options, &stats); });
+        options.progress = fraction_line(args.progress, args.quiet, "extracting the mesh");
+        mesh = named_step(args.input, "extracting the mesh", [&] {
+            try {
+                return extract(volume, args.iso, options, &stats);
+            } catch (...) {
+                end_progress_line(); // the error message starts its own line
+                throw;
+            }
+        });
         const auto stop = std::chrono::steady_clock::now();
         runs.push_back(std::chrono::duration<double>(stop - start).count());
     }
@@ -157,6 +167,10 @@ void add_extract(CLI::App& app)
         ->check(whole_number(1, 1000000));
     cmd->add_flag("--no-topology", args->no_topology,
                   "Skip the mesh topology (saves time and about 24 bytes per triangle; JSON topology: null)");
+    auto* progress = cmd->add_flag("--progress", args->progress,
+                                   "Progress lines on stderr even when it is not a terminal");
+    cmd->add_flag("--quiet", args->quiet, "No progress line (shown on a terminal when extraction takes over a second)")
+        ->excludes(progress);
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT, extracts the triangle mesh of the isosurface at ISO with Marching Cubes 33\n"

@@ -42,6 +42,7 @@ struct VerifyArgs {
     int threads = 0;
     bool json = false;
     bool progress = false;
+    bool quiet = false;
     std::string failures;
     int max_failures = 20;
     std::string dataset;
@@ -287,7 +288,7 @@ void run_verify(const VerifyArgs& args)
         options.threads = args.threads;
         options.failures_dir = failures;
         options.max_failures = args.max_failures;
-        options.progress = progress_line(args.progress, "fields");
+        options.progress = progress_line(args.progress, args.quiet, "fields");
         try {
             report = verify(options);
         } catch (...) {
@@ -302,7 +303,7 @@ void run_verify(const VerifyArgs& args)
         options.threads = args.threads;
         options.failures_dir = failures;
         options.max_failures = args.max_failures;
-        options.progress = progress_line(args.progress, "files");
+        options.progress = progress_line(args.progress, args.quiet, "files");
         try {
             report = verify_dataset(args.dataset, options);
         } catch (...) {
@@ -428,8 +429,9 @@ void add_verify(CLI::App& app)
         ->type_name("N")
         ->check(whole_number(0, std::numeric_limits<int>::max()));
     cmd->add_flag("--json", args->json, "Print one JSON object instead of the tables");
-    cmd->add_flag("--progress", args->progress,
-                  "Progress lines on stderr even when it is not a terminal");
+    auto* progress = cmd->add_flag("--progress", args->progress,
+                                   "Progress lines on stderr even when it is not a terminal");
+    cmd->add_flag("--quiet", args->quiet, "No progress lines (shown on a terminal by default)")->excludes(progress);
     cmd->footer(
         "For every field, the Euler characteristic, Betti numbers b0 b1 b2 and boundary loops of "
         "the\n"

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <chrono>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -411,9 +412,10 @@ std::string rate_text(double per_second)
 
 /// The progress line on stderr: rewritten in place about once a second when stderr is a
 /// terminal (or printed as lines when `forced` and it is not), and always a final line.
-ProgressCallback progress_line(bool forced, const std::string& what)
+ProgressCallback progress_line(bool forced, bool quiet, const std::string& what)
 {
     line_open = false;
+    if (quiet) return {};
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     struct State {
         double last = -1;
@@ -437,6 +439,41 @@ ProgressCallback progress_line(bool forced, const std::string& what)
         } else {
             std::cerr << line << '\n' << std::flush;
         }
+    };
+}
+
+Progress fraction_line(bool forced, bool quiet, const std::string& what)
+{
+    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    if (quiet || !(tty || forced)) return {};
+    struct State {
+        std::chrono::steady_clock::time_point start = std::chrono::steady_clock::now();
+        double last = -1;
+    };
+    auto state = std::make_shared<State>();
+    // Called by extract() from one worker thread at a time; line_open is read by the main thread
+    // only after extract() has joined them.
+    return [tty, what, state](double fraction) {
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - state->start).count();
+        const bool final = fraction >= 1.0;
+        if (tty && final) {
+            if (line_open) std::cerr << "\r\x1b[K" << std::flush;
+            line_open = false;
+            return true;
+        }
+        const double gap = tty ? 0.25 : 1.0;
+        if (!final && ((tty && seconds < 1.0) || seconds - state->last < gap)) return true;
+        state->last = seconds;
+        const std::string line = what + ": " + std::to_string(static_cast<int>(100 * fraction)) + "%, " +
+                                 sig(seconds, 2) + " s";
+        if (tty) {
+            std::cerr << '\r' << line << "\x1b[K" << std::flush;
+            line_open = true;
+        } else {
+            std::cerr << line << '\n' << std::flush;
+        }
+        return true;
     };
 }
 

@@ -118,9 +118,17 @@ std::string rate_text(double per_second);
 
 /// The progress of verify and dataset on stderr: redrawn in place on a terminal,
 /// about once a second; when stderr is not a terminal, lines only if `forced`; always a final line.
-ProgressCallback progress_line(bool forced, const std::string& what);
+/// Empty (no callback, nothing printed) when `quiet`.
+ProgressCallback progress_line(bool forced, bool quiet, const std::string& what);
 /// Ends a half-drawn progress line, so that an error message that follows starts its own line.
 void end_progress_line();
+
+/// Progress of one long step of extract ("extracting the mesh: 43%, 1.2 s") on stderr: on a
+/// terminal, redrawn in place from one second into the step, at most 4 times a second, and
+/// erased when the step ends (so the summary line starts clean); when stderr is not a terminal,
+/// lines about once a second and a final 100% line only if `forced`. Empty (no callback) when
+/// `quiet` or when there is nothing to show.
+Progress fraction_line(bool forced, bool quiet, const std::string& what);
 
 /// Throws `error` again with "path: " in front of its message, unless the message names the path.
 [[noreturn]] void rethrow_naming(const Error& error, const std::string& path);

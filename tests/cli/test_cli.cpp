@@ -305,6 +305,25 @@ TEST(Cli, ExtractNoTopology)
     EXPECT_EQ(line.out.find("euler"), std::string::npos) << line.out;
 }
 
+TEST(Cli, ExtractProgressOnlyWhenAskedOrOnATerminal)
+{
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    const Result plain = run("extract " + sphere + " -i " + kIso); // stderr is not a terminal here
+    ASSERT_EQ(plain.code, 0) << plain.err;
+    EXPECT_EQ(plain.err, "");
+    const Result forced = run("extract " + sphere + " -i " + kIso + " --progress");
+    ASSERT_EQ(forced.code, 0) << forced.err;
+    EXPECT_EQ(forced.out.substr(0, forced.out.find(" in ")), plain.out.substr(0, plain.out.find(" in "))) << forced.out;
+    EXPECT_EQ(std::count(forced.out.begin(), forced.out.end(), '\n'), 1) << forced.out; // just the summary line
+    EXPECT_EQ(forced.err.rfind("extracting the mesh: ", 0), 0u) << forced.err;
+    EXPECT_NE(forced.err.find("extracting the mesh: 100%, "), std::string::npos) << forced.err;
+    const Result quiet = run("extract " + sphere + " -i " + kIso + " --quiet");
+    ASSERT_EQ(quiet.code, 0) << quiet.err;
+    EXPECT_EQ(quiet.err, "");
+    expect_usage_error(run("extract " + sphere + " -i " + kIso + " --quiet --progress"), "excludes");
+}
+
 TEST(Cli, ExtractHeaderlessRaw)
 {
     const fs::path dir = test::temp_dir();
