@@ -13,7 +13,7 @@
 #include <thread>
 
 #include "common.hpp"
-#include "io/atomic_file.hpp"
+#include "atomic_file.hpp"
 
 namespace cmc33::cli {
 

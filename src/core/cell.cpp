@@ -4,10 +4,10 @@
 #include <string>
 
 #include "cmc33/error.hpp"
-#include "core/cube.hpp"
-#include "core/decide.hpp"
-#include "core/placement.hpp"
-#include "tables/mc33_tables.hpp"
+#include "cube.hpp"
+#include "decide.hpp"
+#include "placement.hpp"
+#include "mc33_tables.hpp"
 
 namespace cmc33 {
 

@@ -18,8 +18,8 @@
 
 #include "cmc33/cell.hpp"
 #include "cmc33/extract.hpp"
-#include "core/cube.hpp"
-#include "tables/mc33_tables.hpp"
+#include "cube.hpp"
+#include "mc33_tables.hpp"
 
 namespace cmc33::detail {
 

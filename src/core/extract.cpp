@@ -1,5 +1,5 @@
 // extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges), public in
-// include/cmc33/passes.hpp, each over a range of sample planes [k0, k1):
+// src/core/include/cmc33/passes.hpp, each over a range of sample planes [k0, k1):
 //   1. count: per row of cells, the case code of each cell from the rows' above-flags (rows whose
 //      samples are all on one side are skipped), the face and interior tests of the cells that
 //      have them, and the number of vertices (crossed edges owned by the row's samples, interior
@@ -37,11 +37,11 @@
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/passes.hpp"
-#include "core/cube.hpp"
-#include "core/decide.hpp"
-#include "core/parallel.hpp"
-#include "core/placement.hpp"
-#include "tables/mc33_tables.hpp"
+#include "cube.hpp"
+#include "decide.hpp"
+#include "parallel.hpp"
+#include "placement.hpp"
+#include "mc33_tables.hpp"
 
 namespace cmc33 {
 namespace {

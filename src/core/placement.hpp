@@ -16,7 +16,7 @@
 #include <algorithm>
 #include <cstdint>
 
-#include "core/cube.hpp"
+#include "cube.hpp"
 
 namespace cmc33::detail {
 

@@ -1,4 +1,4 @@
-#include "io/byte_source.hpp"
+#include "byte_source.hpp"
 
 #include <algorithm>
 #include <array>

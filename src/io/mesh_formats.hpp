@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the mesh formats behind io::read_mesh / io::write_mesh (include/cmc33/io.hpp), and the
+// Internal: the mesh formats behind io::read_mesh / io::write_mesh (src/io/include/cmc33/io.hpp), and the
 // small text and byte helpers they share (defined in mesh_io.cpp).
 //
 // Readers parse a whole file image held in memory (`bytes`, exactly the file's size) and name the

@@ -18,8 +18,8 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
-#include "io/atomic_file.hpp"
-#include "io/mesh_formats.hpp"
+#include "atomic_file.hpp"
+#include "mesh_formats.hpp"
 
 namespace cmc33::io {
 namespace detail {

@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-#include "io/mesh_formats.hpp"
+#include "mesh_formats.hpp"
 
 namespace cmc33::io::detail {
 namespace {

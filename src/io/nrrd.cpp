@@ -15,9 +15,9 @@
 #include <vector>
 
 #include "cmc33/io.hpp"
-#include "io/atomic_file.hpp"
-#include "io/byte_source.hpp"
-#include "io/volume_formats.hpp"
+#include "atomic_file.hpp"
+#include "byte_source.hpp"
+#include "volume_formats.hpp"
 
 namespace cmc33::io::detail {
 namespace {

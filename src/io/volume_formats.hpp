@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the volume formats behind io::read_volume / io::write_volume (include/cmc33/io.hpp),
+// Internal: the volume formats behind io::read_volume / io::write_volume (src/io/include/cmc33/io.hpp),
 // and the helpers they share (defined in volume_io.cpp).
 //
 // A reader parses its header into a `Grid` (type, dims, spacing, origin) and a `Storage` (where
@@ -30,7 +30,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/volume.hpp"
-#include "io/byte_source.hpp"
+#include "byte_source.hpp"
 
 namespace cmc33::io::detail {
 

@@ -1,6 +1,6 @@
 // Exact predicates and triangle intersection tests (contract in exact_geometry.hpp).
 
-#include "topology/exact_geometry.hpp"
+#include "exact_geometry.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -1,7 +1,7 @@
 // One cell of the field-topology verifier. The method and the proofs it relies on are in the
 // comment block at the top of field_topology.cpp; this file refers to its steps as (F1)..(F6).
 
-#include "topology/field_cell.hpp"
+#include "field_cell.hpp"
 
 #include <memory>
 

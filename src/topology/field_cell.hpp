@@ -10,7 +10,7 @@
 
 #include <cstdint>
 
-#include "topology/field_exact.hpp"
+#include "field_exact.hpp"
 
 namespace cmc33::topology::detail {
 

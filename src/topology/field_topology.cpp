@@ -105,7 +105,7 @@
 #include <vector>
 
 #include "cmc33/topology.hpp"
-#include "topology/field_cell.hpp"
+#include "field_cell.hpp"
 
 namespace cmc33 {
 namespace topology::detail {

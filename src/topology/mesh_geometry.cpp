@@ -1,5 +1,5 @@
 // The mesh in space: coincident vertices, zero-area triangles, improperly meeting triangle pairs,
-// and the topology after welding by position (contract in include/cmc33/topology.hpp).
+// and the topology after welding by position (contract in src/topology/include/cmc33/topology.hpp).
 //
 //   1. weld: vertices sorted by position; equal floats (with -0 == +0) share one welded id;
 //   2. triangles whose welded corners repeat or are collinear (exactly) are zero-area;
@@ -21,7 +21,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/topology.hpp"
-#include "topology/exact_geometry.hpp"
+#include "exact_geometry.hpp"
 
 namespace cmc33 {
 namespace {

@@ -1,4 +1,4 @@
-// Combinatorial invariants of an indexed triangle mesh (contract in include/cmc33/topology.hpp).
+// Combinatorial invariants of an indexed triangle mesh (contract in src/topology/include/cmc33/topology.hpp).
 //
 // Everything comes from one structure: for every vertex v, the (next, previous) vertex pair of each
 // non-degenerate triangle at v, bucketed by v with a counting sort (CSR). Per vertex, the 2k
@@ -22,7 +22,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/topology.hpp"
-#include "topology/union_find.hpp"
+#include "union_find.hpp"
 
 namespace cmc33 {
 namespace {

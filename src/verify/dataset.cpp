@@ -32,9 +32,9 @@
 #include "cmc33/io.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
-#include "core/parallel.hpp"
-#include "io/atomic_file.hpp"
-#include "verify/verify_detail.hpp"
+#include "parallel.hpp"
+#include "atomic_file.hpp"
+#include "verify_detail.hpp"
 
 namespace cmc33 {
 namespace {

@@ -1,4 +1,4 @@
-// The random fields of the stress test (contract in include/cmc33/verify.hpp).
+// The random fields of the stress test (contract in src/verify/include/cmc33/verify.hpp).
 //
 // Every item has its own SplitMix64 generator (Steele, Lea and Flood 2014), seeded from
 // (seed, kind, n) through the generator's own finalizer, so a field is a pure function of those

@@ -12,7 +12,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/verify.hpp"
-#include "verify/verify_detail.hpp"
+#include "verify_detail.hpp"
 
 namespace cmc33 {
 namespace verification::detail {

@@ -21,8 +21,8 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
-#include "core/parallel.hpp"
-#include "verify/verify_detail.hpp"
+#include "parallel.hpp"
+#include "verify_detail.hpp"
 
 namespace cmc33 {
 namespace {

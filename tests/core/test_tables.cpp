@@ -12,8 +12,8 @@
 #include <string>
 #include <utility>
 
-#include "core/cube.hpp"
-#include "tables/mc33_tables.hpp"
+#include "cube.hpp"
+#include "mc33_tables.hpp"
 #include "test_support.hpp"
 
 namespace {

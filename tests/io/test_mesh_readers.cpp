@@ -16,8 +16,8 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
-#include "io/atomic_file.hpp"
-#include "io/mesh_formats.hpp"
+#include "atomic_file.hpp"
+#include "mesh_formats.hpp"
 #include "test_support.hpp"
 
 namespace {

@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "cmc33/topology.hpp"
-#include "topology/field_cell.hpp"
-#include "topology/field_exact.hpp"
+#include "field_cell.hpp"
+#include "field_exact.hpp"
 
 namespace cmc33::topology::detail {
 namespace {

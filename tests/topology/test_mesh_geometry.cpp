@@ -21,7 +21,7 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
-#include "topology/exact_geometry.hpp"
+#include "exact_geometry.hpp"
 
 namespace {
 

@@ -1,4 +1,4 @@
-// Memory for cmc33::Buffer (include/cmc33/mesh.hpp). A mesh of millions of triangles is written
+// Memory for cmc33::Buffer (src/base/include/cmc33/mesh.hpp). A mesh of millions of triangles is written
 // once, in parallel; with 4 KiB pages most of that time goes to page faults. Blocks of 4 MiB and
 // more are aligned to 2 MiB and advised for transparent huge pages (Linux, when THP is in
 // "madvise" or "always" mode; elsewhere the advice is ignored and they are plain pages).
