@@ -131,7 +131,8 @@ TEST(Passes, AnySplitAndAnyFirstIdsGiveExtractsMesh)
             const cmc33::Mesh m = cmc33::extract(c.volume, c.iso, opt);
             ASSERT_GT(m.triangle_count(), 100u);
             for (const auto& b : splits(c.volume.dims()[2])) {
-                for (const auto& [fv, ft] : {std::pair<std::int64_t, std::int64_t>{0, 0}, {1000003, 77}}) {
+                for (const auto& ids : {std::pair<std::int64_t, std::int64_t>{0, 0}, {1000003, 77}}) {
+                    const std::int64_t fv = ids.first, ft = ids.second; // not bindings: clang 14 lambdas
                     const std::string what = std::string(cmc33::method_name(method)) + " iso " + std::to_string(c.iso) +
                                              " ranges " + std::to_string(b.size() - 1) + " from " + std::to_string(b[1]) +
                                              " ids from " + std::to_string(fv);
@@ -343,7 +344,8 @@ TEST(Passes, MisuseIsRefusedBeforeAnyWrite)
     const GridView<std::uint8_t> g = v.view<std::uint8_t>();
     const ExtractOptions opt;
     using cmc33::Status;
-    for (const auto& [k0, k1] : {std::pair<std::int64_t, std::int64_t>{-1, 3}, {3, 3}, {5, 2}, {0, 33}}) {
+    for (const auto& range : {std::pair<std::int64_t, std::int64_t>{-1, 3}, {3, 3}, {5, 2}, {0, 33}}) {
+        const std::int64_t k0 = range.first, k1 = range.second;
         EXPECT_EQ(status_of([&] { (void)cmc33::count(g, 100.5, opt, k0, k1); }), Status::invalid_argument) << k0 << " " << k1;
     }
     const RangeCounts a = cmc33::count(g, 100.5, opt, 0, 10), b = cmc33::count(g, 100.5, opt, 11, 32);
