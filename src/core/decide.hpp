@@ -1,6 +1,7 @@
 #pragma once
-// The decisions of one cell: face tests, interior tests, and the policy of each method.
-// Used by the extractor's counting pass and by analyze_cell(); `report` is null in the extractor.
+// The decisions of one cell: face tests, interior tests, and the policy of each method: a pure
+// kernel (no report, no strings), used by the extractor's passes and by analyze_cell(), which
+// derives its report from the Decision (cell.cpp).
 //
 // Values are differences to iso. The sign rule (design.md): a value >= 0 is above. It applies to
 // samples, face saddles and the saddles of the sweeping slices alike.
@@ -16,7 +17,6 @@
 #include <cmath>
 #include <limits>
 
-#include "cmc33/cell.hpp"
 #include "cmc33/extract.hpp"
 #include "cube.hpp"
 #include "mc33_tables.hpp"
@@ -102,20 +102,6 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
     const R& D = v[p[3]];
     const int num = sgn(A * C - B * D);
     return a_above ? num >= 0 : num <= 0;
-}
-
-/// The face saddle's value minus iso, for reports (rounded; the decision does not use it).
-/// Computed in long double from the samples: with values near +-1e308, A C and A + C pass the
-/// double range (x86-64 and AArch64 long doubles reach 1e4932), while the saddle, which lies
-/// between the face's values, fits a double again. Where long double is double, such values give
-/// inf or NaN here (callers print them as out of range) and the decision stays exact.
-inline double face_saddle(const double* raw, double iso, int f)
-{
-    const auto p = face_cycle(f);
-    const long double i = static_cast<long double>(iso);
-    const long double A = static_cast<long double>(raw[p[0]]) - i, B = static_cast<long double>(raw[p[1]]) - i,
-                      C = static_cast<long double>(raw[p[2]]) - i, D = static_cast<long double>(raw[p[3]]) - i;
-    return static_cast<double>((A * C - B * D) / (A + C - B - D));
 }
 
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
@@ -261,58 +247,44 @@ inline double t_alt(const double* v, int edge)
     return t;
 }
 
-/// The numbers `cmc33 cell` shows (plain values, without the eps of the decisions), computed in
-/// long double from the samples so that values near +-1e308 give finite roots and saddles (and
-/// inf, not NaN, for a, b, c and F where those pass the double range; see face_saddle).
-inline void report_numbers(const double* raw, double iso, double t_lewiner, const Variant& var, InteriorReport& r)
+/// Algorithm 2 of Custodio et al. 2013 (Sec. 6.4), generalised to every variant with an interior
+/// ambiguity (cases 4, 6, 7, 10, 12 and 13.5): the face tests have chosen `var`; the interior test
+/// decides whether the tunnel is there, and for 13.5 which way it faces (tiling 1: the above
+/// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 every branch is
+/// tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces joined); the
+/// legacy policy of mc33-lewiner is read from the variant (Variant::lewiner).
+template <class R> int algorithm2(const Variant& var, const EpsT<R>* ve, const double* v, Method method)
 {
-    using L = long double;
-    L vl[8];
-    for (int q = 0; q < 8; ++q) vl[q] = static_cast<L>(raw[q]) - static_cast<L>(iso);
-    const SweepT<L> s(vl, var.axis, var.corner), lewiner(vl, var.lewiner_axis, var.lewiner_corner);
-    r.tested = true;
-    r.test = var.test == kTestTunnel ? "tunnel" : "13.5";
-    r.axis = var.axis, r.corner_a = var.corner, r.corner_c = var.corner ^ 7;
-    r.lewiner_axis = var.lewiner_axis, r.lewiner_corner = var.lewiner_corner, r.lewiner_edge = var.lewiner_edge;
-    const L a = s.a(), b = s.b(), c = s.c();
-    r.a = static_cast<double>(a), r.b = static_cast<double>(b), r.c = static_cast<double>(c);
-    const L t_max = a != 0 ? -b / (2 * a) : L(kNaN);
-    r.t_max = static_cast<double>(t_max);
-    r.f_t_max = a != 0 ? static_cast<double>(s.F(t_max)) : kNaN;
-    r.t_alt = t_lewiner;
-    r.f_t_alt = static_cast<double>(lewiner.F(static_cast<L>(t_lewiner)));
-    r.t1 = r.t2 = kNaN;
-    L t1 = static_cast<L>(kNaN), t2 = static_cast<L>(kNaN);
-    const L disc = b * b - 4 * a * c;
-    if (a != 0 && disc >= 0) {
-        const L q = -0.5L * (b + std::copysign(std::sqrt(disc), b)); // stable roots
-        t1 = q / a, t2 = q != 0 ? c / q : t1;
-        if (t1 > t2) std::swap(t1, t2);
-        r.t1 = static_cast<double>(t1), r.t2 = static_cast<double>(t2);
+    using E = EpsT<R>;
+    if (method == Method::mc33_lewiner) {
+        if (var.lewiner & kLewinerSkips) return 0; // Issue IV: never tested
+        if (var.lewiner & kLewinerTAlt) {
+            // Issue III: the slice at Lewiner's t_alt (Eq. 8) instead of t_max; for 13.5 condition
+            // (iii) there, its orientation never tested (Sec. 5.1.1, Appendix A)
+            const double t = t_alt(v, var.lewiner_edge);
+            if (var.test == kTest13_5) return Sweep(v, var.lewiner_axis, var.lewiner_corner).F(t) > 0 ? 1 : 0;
+            const SweepT<E> lw(ve, var.lewiner_axis, var.lewiner_corner);
+            return slice_joins(lw, E{R(t), R(0.0)}) ? 1 : 0;
+        }
     }
-    const auto saddle = [&](L t) -> std::array<double, 2> {
-        if (std::isnan(t)) return {kNaN, kNaN};
-        const L a_t = SweepT<L>::at(s.A0, s.A1, t), b_t = SweepT<L>::at(s.B0, s.B1, t),
-                d_t = SweepT<L>::at(s.D0, s.D1, t);
-        const L den = s.den(t);
-        return {static_cast<double>((a_t - d_t) / den), static_cast<double>((a_t - b_t) / den)};
-    };
-    r.saddle1 = saddle(t1), r.saddle2 = saddle(t2);
+    const SweepT<E> sweep(ve, var.axis, var.corner);
+    if (var.test == kTestTunnel) return chernyaev_joined(sweep) ? 1 : 0;
+    const int orientation = algorithm1(sweep); // 13.5 under cmc33
+    return orientation == 0 ? 0 : orientation > 0 ? 1 : 2;
 }
 
 struct Decision {
     const Variant* variant;
     int tiling; ///< 0 no tunnel, 1 tunnel (13.5: facing the above corner), 2 (13.5: facing below)
     int subcase;
+    unsigned joined; ///< the face tests: bit i for the i-th ambiguous face of the configuration
 };
 
 /// decide() in the number type R (Filtered: may throw Uncertain; mpq_class: exact). `raw` are the
-/// corner samples, `v` the same minus iso rounded to double (for reports and mc33-lewiner's t_alt);
-/// the decisions use raw - iso computed in R.
-template <class R>
-Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method, CellReport* report)
+/// corner samples, `v` the same minus iso rounded to double (their signs, and mc33-lewiner's
+/// t_alt); the decisions use raw - iso computed in R.
+template <class R> Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
 {
-    using E = EpsT<R>;
     R w[8];
     for (int q = 0; q < 8; ++q) w[q] = R(raw[q]) - R(iso);
     const unsigned amb = kAmbiguousFaces[config];
@@ -322,64 +294,22 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
         for (int f = 0; f < 6; ++f) {
             if (!((amb >> f) & 1u)) continue;
             if (face_joined<R>(w, v[face_cycle(f)[0]] >= 0, f)) bits |= 1u << i;
-            if (report) report->faces[f] = {true, face_saddle(raw, iso, f), ((bits >> i) & 1u) != 0, true};
             ++i;
-        }
-    } else if (report) {
-        for (int f = 0; f < 6; ++f) {
-            if ((amb >> f) & 1u) report->faces[f] = {true, 0, false, false};
         }
     }
     const Variant* var = &kVariants[kVariantOffset[config] + bits];
-    Decision d{var, 0, var->subcase};
-    if (var->test == kTestNone || method == Method::mc) return d;
-
-    InteriorReport* r = report ? &report->interior : nullptr;
-    E ve[8];
+    if (var->test == kTestNone || method == Method::mc) return {var, 0, var->subcase, bits};
+    EpsT<R> ve[8];
     for (int q = 0; q < 8; ++q) ve[q] = {w[q], R(1.0)};
-    const SweepT<E> sweep(ve, var->axis, var->corner);
-    const Sweep lewiner(v, var->lewiner_axis, var->lewiner_corner);
-    const double t_lewiner = t_alt(v, var->lewiner_edge);
-    if (r) report_numbers(raw, iso, t_lewiner, *var, *r);
-    const int base = kBaseCase[config];
-    bool tunnel = false;
-    int tiling = 1;
-    if (var->test == kTestTunnel) {
-        if (method == Method::cmc33 || base == 4 || base == 10) {
-            tunnel = chernyaev_joined(sweep);
-        } else {
-            // 6, 7, 12 in mc33-lewiner: the slice at Lewiner's t_alt instead of t_max
-            const SweepT<E> lw(ve, var->lewiner_axis, var->lewiner_corner);
-            tunnel = slice_joins(lw, E{R(t_lewiner), R(0.0)});
-        }
-        if (method == Method::mc33_lewiner && var->lewiner_skips) {
-            tunnel = false; // cases 10 and 12 with both faces joined: never tested (Sec. 5.4)
-            if (r) r->skipped = true;
-        }
-    } else if (method == Method::cmc33) {
-        const int orientation = algorithm1(sweep);
-        tunnel = orientation != 0;
-        tiling = orientation >= 0 ? 1 : 2;
-    } else {
-        // mc33-lewiner on 13.5: condition (iii) at Lewiner's height, tunnel orientation never
-        // tested (Custodio et al. Sec. 5.1.1, Appendix A).
-        tunnel = lewiner.F(t_lewiner) > 0;
-    }
-    if (r) r->tunnel = tunnel;
-    if (!tunnel) return d;
-    if (r && var->test == kTest13_5) {
-        // tiling 1 faces the above corner of the isolated diagonal (kept in lewiner_corner)
-        r->tunnel_corner = tiling == 1 ? var->lewiner_corner : var->lewiner_corner ^ 7;
-    }
-    return {var, tiling, var->tunnel_subcase};
+    const int tiling = algorithm2<R>(*var, ve, v, method);
+    return {var, tiling, tiling != 0 ? var->tunnel_subcase : var->subcase, bits};
 }
 
 /// Decides one cell with `config` not 0 or 255: in filtered double arithmetic, and where rounding
 /// could change a sign, again exactly.
 /// `raw`: the eight corner samples (corner order of cube.hpp). `integers`: try the 128-bit integer
 /// path first (the extractor passes true for integer sample types).
-inline Decision decide(const double* raw, double iso, unsigned config, Method method, CellReport* report = nullptr,
-                       bool integers = true)
+inline Decision decide(const double* raw, double iso, unsigned config, Method method, bool integers)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
@@ -388,13 +318,13 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
         if (const double scale = small_integer_scale(raw, iso); scale != 0) {
             double scaled[8];
             for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
-            return decide_in<Int128>(scaled, iso * scale, v, config, method, report);
+            return decide_in<Int128>(scaled, iso * scale, v, config, method);
         }
     }
     try {
-        return decide_in<Filtered>(raw, iso, v, config, method, report);
+        return decide_in<Filtered>(raw, iso, v, config, method);
     } catch (const Uncertain&) {
-        return decide_in<mpq_class>(raw, iso, v, config, method, report);
+        return decide_in<mpq_class>(raw, iso, v, config, method);
     }
 }
 

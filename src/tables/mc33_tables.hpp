@@ -31,6 +31,12 @@ enum TestKind : std::uint8_t {
     kTest13_5 = 2,   ///< 13.5: Algorithm 1 of Custodio et al. 2013 and the tunnel orientation
 };
 
+/// mc33-lewiner's policy for a variant with an interior test (Custodio et al. 2013, Sec. 5).
+enum LewinerPolicy : std::uint8_t {
+    kLewinerTAlt = 1,  ///< tests the slice at t_alt, not t_max (cases 6, 7, 12; 13.5's condition iii)
+    kLewinerSkips = 2, ///< never tests: cases 10 and 12 with both faces joined (Issue IV, Algorithm 2)
+};
+
 struct Variant {
     std::uint8_t subcase;        ///< index into subcase_name(); the subcase without tunnel
     std::uint8_t tunnel_subcase; ///< the subcase when the interior test finds a tunnel
@@ -40,7 +46,7 @@ struct Variant {
     std::uint8_t lewiner_axis;   ///< mc33-lewiner: sweep axis
     std::uint8_t lewiner_corner; ///< mc33-lewiner: A0
     std::uint8_t lewiner_edge;   ///< mc33-lewiner: the crossed edge whose crossing gives t_alt
-    std::uint8_t lewiner_skips;  ///< mc33-lewiner: 1 on the branch of cases 10/12 it never tests
+    std::uint8_t lewiner;        ///< mc33-lewiner's policy: kLewinerTAlt | kLewinerSkips
     Tiling tilings[3];
 };
 

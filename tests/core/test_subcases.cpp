@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <random>
 #include <string>
 
 #include "cmc33/cell.hpp"
+#include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
+#include "decide.hpp"
 
 namespace {
 
@@ -161,6 +164,68 @@ TEST(Methods, McNeverTestsAndLewinerSkipsTheJoinedBranch)
         skipped += lw.interior.skipped;
     }
     EXPECT_GE(skipped, 1); // the complement of 10.1.x / 12.1.x lands on the joined branch
+}
+
+// Algorithm 2 of the paper (Sec. 6.4, case 10; the same holds for case 12): with both ambiguous
+// faces joined, cmc33 runs the interior test (lines 16-20, which the original implementation
+// replaced by "case 10.1.1") and finds x.1.2 where the field has a tunnel; mc33-lewiner never tests
+// and always answers x.1.1. The kernel (detail::algorithm2 through detail::decide) is checked
+// against the independent field topology on random cells of that branch.
+TEST(Algorithm2, TheJoinedBranchOfCases10And12IsTestedByCmc33AndSkippedByLewiner)
+{
+    std::mt19937_64 rng(2013);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int branch = 0, tunnels = 0;
+    for (int n = 0; n < 400000 && branch < 400; ++n) {
+        std::array<double, 8> v{};
+        unsigned config = 0;
+        for (int c = 0; c < 8; ++c) {
+            v[static_cast<std::size_t>(c)] = u(rng);
+            config |= static_cast<unsigned>(v[static_cast<std::size_t>(c)] >= 0) << c;
+        }
+        const int base = cmc33::detail::kBaseCase[config];
+        if (base != 10 && base != 12) continue;
+        const cmc33::detail::Decision d = cmc33::detail::decide(v.data(), 0.0, config, Method::cmc33, false);
+        if (!(d.variant->lewiner & cmc33::detail::kLewinerSkips)) continue;
+        ++branch;
+        const cmc33::CellReport lw = cmc33::analyze_cell(v, 0.0, Method::mc33_lewiner);
+        EXPECT_TRUE(lw.interior.skipped);
+        EXPECT_FALSE(lw.interior.tunnel);
+        EXPECT_EQ(lw.subcase, d.variant->subcase); // x.1.1 always
+        const cmc33::CellReport ours = cmc33::analyze_cell(v, 0.0, Method::cmc33);
+        EXPECT_EQ(ours.subcase, d.subcase);
+        EXPECT_EQ(ours.interior.tunnel, d.tiling != 0);
+        tunnels += d.tiling != 0;
+        // the tunnel is there exactly when the trilinear level set in the cell is a tube
+        const cmc33::FieldTopology f = field_of(v, 0.0);
+        ASSERT_TRUE(f.determined) << f.why;
+        EXPECT_EQ(f.euler == 0, d.tiling != 0) << "case " << base << " config " << config;
+        EXPECT_EQ(cmc33::mesh_topology(ours.mesh).euler, f.euler);
+    }
+    EXPECT_GE(branch, 100) << "too few cells on the joined branch";
+    EXPECT_GT(tunnels, 0) << "no x.1.2 found: the branch would look untested";
+    EXPECT_LT(tunnels, branch) << "only x.1.2 found";
+}
+
+// analyze_cell's mesh is extract() of the cell as a 2x2x2 grid: the same code, so the same bytes.
+TEST(AnalyzeCell, ItsMeshIsExtractOfTheCell)
+{
+    for (const auto& cell : kCells) {
+        for (const Method m : {Method::cmc33, Method::mc33_lewiner, Method::mc}) {
+            const cmc33::CellReport r = cmc33::analyze_cell(cell.values, 0.0, m);
+            cmc33::ExtractOptions o;
+            o.method = m;
+            o.threads = 1;
+            cmc33::ExtractStats stats;
+            const cmc33::Mesh e =
+                cmc33::extract(cmc33::GridView<double>::dense(cell.values.data(), {2, 2, 2}), 0.0, o, &stats);
+            EXPECT_EQ(r.mesh.positions, e.positions) << cell.subcase;
+            EXPECT_EQ(r.mesh.triangles, e.triangles) << cell.subcase;
+            if (r.config != 0 && r.config != 255) {
+                EXPECT_EQ(stats.cells_per_subcase[static_cast<std::size_t>(r.subcase)], 1) << cell.subcase;
+            }
+        }
+    }
 }
 
 } // namespace

@@ -39,6 +39,8 @@ BASE_REPS = {0: [], 1: [0], 2: [0, 1], 3: [1, 2], 4: [3, 4], 5: [0, 1, 2], 6: [0
              12: [1, 2, 3, 4], 13: [0, 3, 5, 6], 14: [0, 2, 3, 4]}
 
 TEST_NONE, TEST_TUNNEL, TEST_13_5 = 0, 1, 2
+# mc33-lewiner's policy per variant: bits of Variant::lewiner (kLewinerTAlt, kLewinerSkips)
+LEWINER_T_ALT, LEWINER_SKIPS = 1, 2
 
 
 def cfg(corners):
@@ -388,7 +390,7 @@ def variants():
             name = label(config, joined, ls)
             v = {"config": config, "joined": joined, "base": base, "test": TEST_NONE,
                  "axis": 0, "corner": 0, "lw_axis": 0, "lw_corner": 0, "lw_edge": 0,
-                 "lewiner_skips": 0, "tilings": [tiling(ls)]}
+                 "lewiner": 0, "tilings": [tiling(ls)]}
             v["subcase"] = SUB[name] if name in SUB else SUB[name + ".1"]
             if name in ("4.1", "6.1", "7.4", "10.1", "12.1"):
                 (i, j, ri, rj), = tube_pairs(config, joined, ls)
@@ -407,10 +409,14 @@ def variants():
                 else:
                     raise AssertionError("no reference edge")
                 v["lw_axis"], v["lw_corner"] = axis, P
-                # the branch of cases 10 and 12 that Lewiner et al.'s implementation misses: the
-                # minority... for these 4-corner cases: the above corners joined on the faces
+                # mc33-lewiner's policy (Custodio et al. 2013, Sec. 5.3): cases 6, 7 and 12 test
+                # the slice at t_alt instead of t_max (Issue III); 4 and 10 keep Chernyaev's t_max
+                if base in (6, 7, 12):
+                    v["lewiner"] |= LEWINER_T_ALT
+                # the branch of cases 10 and 12 that Lewiner et al.'s implementation misses
+                # (Issue IV, lines 16-20 of Algorithm 2): both ambiguous faces joined
                 if base in (10, 12) and all((joined >> f) & 1 for f in amb):
-                    v["lewiner_skips"] = 1
+                    v["lewiner"] |= LEWINER_SKIPS
             elif name == "13.5":
                 regs = regions(config, joined)
                 # the two corners isolated on all their faces: a cap each; they form a diagonal
@@ -431,6 +437,7 @@ def variants():
                 # corner (lewiner_corner = s_plus, which decide() also reads as that corner), t_alt
                 # where the field crosses the x edge leaving it.
                 v["lw_axis"], v["lw_corner"] = 0, s_plus
+                v["lewiner"] = LEWINER_T_ALT  # condition (iii) at t_alt, orientation never tested
                 v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {s_plus, s_plus ^ 1}][0]
             for t, (tris, interior) in enumerate(v["tilings"]):
                 check_tiling(config, ls, tris, interior, (config, joined, name, t))
@@ -478,13 +485,13 @@ def emit(table):
     p("};")
     p("")
     p(f"const Variant kVariants[{len(rows)}] = {{")
-    p("    // subcase, tunnel_subcase, test, axis, corner, lw_axis, lw_corner, lw_edge, lewiner_skips,")
+    p("    // subcase, tunnel_subcase, test, axis, corner, lw_axis, lw_corner, lw_edge, lewiner,")
     p("    // tilings {triangles, interior vertices, first triangle, first interior}   config/joined faces")
     for v, tl in rows:
         t = ", ".join("{%d, %d, %d, %d}" % x for x in tl)
         p("    {%d, %d, %d, %d, %d, %d, %d, %d, %d, {%s}}, // %d/%s %s" % (
             v["subcase"], v.get("tunnel_subcase", v["subcase"]), v["test"], v["axis"], v["corner"],
-            v["lw_axis"], v["lw_corner"], v["lw_edge"], v["lewiner_skips"], t, v["config"],
+            v["lw_axis"], v["lw_corner"], v["lw_edge"], v["lewiner"], t, v["config"],
             "".join(str(f) for f in range(6) if (v["joined"] >> f) & 1) or "-", SUBCASES[v["subcase"]]))
     p("};")
     p("")
