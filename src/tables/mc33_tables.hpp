@@ -50,6 +50,7 @@ struct Variant {
     Tiling tilings[3];
 };
 
+extern const char* const kSubcaseNames[33];      ///< Chernyaev's subcase names, index = Variant::subcase
 extern const std::uint8_t kAmbiguousFaces[256]; ///< bit f: face f has its above corners diagonal
 extern const std::uint8_t kBaseCase[256];       ///< Chernyaev / Lorensen base case 0..14
 extern const std::uint16_t kVariantOffset[257];

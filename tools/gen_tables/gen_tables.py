@@ -468,6 +468,11 @@ def emit(table):
     p("")
     p("namespace cmc33::detail {")
     p("")
+    p(f"const char* const kSubcaseNames[{len(SUBCASES)}] = {{")
+    for i in range(0, len(SUBCASES), 12):
+        p("    " + " ".join('"%s",' % n for n in SUBCASES[i:i + 12]))
+    p("};")
+    p("")
     p("const std::uint8_t kAmbiguousFaces[256] = {")
     vals = [sum(1 << f for f in ambiguous_faces(c)) for c in range(256)]
     for i in range(0, 256, 16):
