@@ -5,14 +5,13 @@
 // A failed allocation says how many bytes it wanted: a mesh too large for memory (or for
 // `ulimit -v`) is reported as such, and the command line names the file it came from.
 
-#include <sys/mman.h>
-
 #include <cstdlib>
 #include <new>
 #include <string>
 
 #include "cmc33/error.hpp"
 #include "cmc33/mesh.hpp"
+#include "portability.hpp"
 
 namespace cmc33::detail {
 
@@ -33,11 +32,9 @@ void* allocate_buffer(std::size_t bytes)
         if (small == nullptr) out_of_memory(bytes);
         return small;
     }
-    void* p = nullptr;
-    if (posix_memalign(&p, kHugePage, bytes) != 0) out_of_memory(bytes);
-#ifdef MADV_HUGEPAGE
-    (void)madvise(p, bytes & ~(kHugePage - 1), MADV_HUGEPAGE); // advice only: failure is harmless
-#endif
+    void* p = aligned_allocate(kHugePage, bytes);
+    if (p == nullptr) out_of_memory(bytes);
+    advise_huge_pages(p, bytes & ~(kHugePage - 1));
     return p;
 }
 
@@ -46,7 +43,7 @@ void deallocate_buffer(void* p, std::size_t bytes) noexcept
     if (bytes < kLarge) {
         ::operator delete(p);
     } else {
-        std::free(p);
+        aligned_free(p);
     }
 }
 

@@ -20,6 +20,7 @@
 #include "cmc33/extract.hpp"
 #include "cube.hpp"
 #include "mc33_tables.hpp"
+#include "portability.hpp"
 
 namespace cmc33::detail {
 
@@ -68,8 +69,9 @@ inline int sgn(const mpq_class& q) { return mpq_sgn(q.get_mpq_t()); }
 
 /// Exact for small integers: with |value - iso| <= 2^15 every polynomial of a decision stays below
 /// 2^111 (the largest, P^2 - Q^2 disc of Algorithm 1, is at most 2^14 * |v|^6), far inside 2^127.
-__extension__ typedef __int128 Int128;
+#if CMC33_HAS_INT128
 inline int sgn(Int128 x) { return x > 0 ? 1 : x < 0 ? -1 : 0; }
+#endif
 inline constexpr double kSmallInteger = 32768.0;
 
 /// 2^k (k <= 8) such that iso * 2^k and every sample * 2^k are integers with
@@ -314,6 +316,7 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
     // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
+#if CMC33_HAS_INT128
     if (integers && method == Method::cmc33) {
         if (const double scale = small_integer_scale(raw, iso); scale != 0) {
             double scaled[8];
@@ -321,6 +324,9 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
             return decide_in<Int128>(scaled, iso * scale, v, config, method);
         }
     }
+#else
+    (void)integers;
+#endif
     try {
         return decide_in<Filtered>(raw, iso, v, config, method);
     } catch (const Uncertain&) {

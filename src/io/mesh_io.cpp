@@ -12,7 +12,6 @@
 #include <system_error>
 
 #include <fcntl.h>
-#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -20,6 +19,7 @@
 #include "cmc33/io.hpp"
 #include "atomic_file.hpp"
 #include "mesh_formats.hpp"
+#include "portability.hpp"
 
 namespace cmc33::io {
 namespace detail {
@@ -289,11 +289,9 @@ public:
         }
         size_ = static_cast<std::size_t>(info.st_size);
         if (size_ == 0) return;
-        void* map = ::mmap(nullptr, size_, PROT_READ, MAP_PRIVATE, file.fd, 0);
-        if (map != MAP_FAILED) {
+        if (const void* map = cmc33::detail::map_readonly(file.fd, size_)) {
             map_ = map;
             data_ = static_cast<const char*>(map);
-            ::madvise(map, size_, MADV_SEQUENTIAL);
             return;
         }
         copy_.resize(size_);
@@ -316,7 +314,7 @@ public:
     }
     ~FileImage()
     {
-        if (map_ != nullptr) ::munmap(map_, size_);
+        cmc33::detail::unmap(map_, size_);
     }
     FileImage(const FileImage&) = delete;
     FileImage& operator=(const FileImage&) = delete;
@@ -324,7 +322,7 @@ public:
     std::string_view bytes() const noexcept { return {data_, size_}; }
 
 private:
-    void* map_ = nullptr;
+    const void* map_ = nullptr;
     const char* data_ = nullptr;
     std::size_t size_ = 0;
     std::string copy_;

@@ -1,0 +1,85 @@
+#pragma once
+// The non-portable pieces of the library in one place, each with its fallback:
+//
+//   Int128 / CMC33_HAS_INT128   128-bit integers (GCC, Clang); without them the decisions take the
+//                               filtered-double / GMP path, which gives the same answers, slower
+//   aligned_allocate / aligned_free / advise_huge_pages
+//                               2 MiB-aligned blocks for large meshes (posix_memalign + madvise;
+//                               _aligned_malloc on Windows; the advice is a no-op where unknown)
+//   map_readonly / unmap        a read-only file mapping for the mesh readers (mmap); nullptr
+//                               where there is none, and the caller reads the file instead
+//
+// The rest of io (open/fstat, fork/exec of verify --cmd, the CLI's sigwait) is POSIX and stays so:
+// cmc33 builds on Linux and macOS with GCC or Clang. GCC-only warning flags are chosen by compiler
+// in cmake/cmc33_warnings.cmake.
+
+#include <cstddef>
+#include <cstdlib>
+
+#if defined(_WIN32)
+#include <malloc.h>
+#else
+#include <sys/mman.h>
+#endif
+
+namespace cmc33::detail {
+
+#if defined(__SIZEOF_INT128__)
+#define CMC33_HAS_INT128 1
+__extension__ typedef __int128 Int128;
+#else
+#define CMC33_HAS_INT128 0
+#endif
+
+/// `bytes` aligned to `alignment` (a power of two, a multiple of sizeof(void*)), or nullptr.
+inline void* aligned_allocate(std::size_t alignment, std::size_t bytes) noexcept
+{
+#if defined(_WIN32)
+    return _aligned_malloc(bytes, alignment);
+#else
+    void* p = nullptr;
+    return posix_memalign(&p, alignment, bytes) == 0 ? p : nullptr;
+#endif
+}
+
+inline void aligned_free(void* p) noexcept
+{
+#if defined(_WIN32)
+    _aligned_free(p);
+#else
+    std::free(p);
+#endif
+}
+
+/// Asks for transparent huge pages on [p, p + bytes) (Linux); advice only, failure is harmless.
+inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) noexcept
+{
+#if defined(MADV_HUGEPAGE)
+    (void)madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+}
+
+/// The first `bytes` of open file `fd`, mapped read-only and advised for sequential reading;
+/// nullptr if it cannot be mapped (the caller reads the file instead).
+inline const void* map_readonly([[maybe_unused]] int fd, [[maybe_unused]] std::size_t bytes) noexcept
+{
+#if defined(_WIN32)
+    return nullptr;
+#else
+    void* map = ::mmap(nullptr, bytes, PROT_READ, MAP_PRIVATE, fd, 0);
+    if (map == MAP_FAILED) return nullptr;
+#if defined(MADV_SEQUENTIAL)
+    (void)::madvise(map, bytes, MADV_SEQUENTIAL);
+#endif
+    return map;
+#endif
+}
+
+inline void unmap([[maybe_unused]] const void* map, [[maybe_unused]] std::size_t bytes) noexcept
+{
+#if !defined(_WIN32)
+    if (map != nullptr) ::munmap(const_cast<void*>(map), bytes);
+#endif
+}
+
+} // namespace cmc33::detail
