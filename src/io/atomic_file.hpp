@@ -21,20 +21,22 @@
 #include <ostream>
 #include <string>
 
+#include "cmc33/io_export.hpp" // verify and the CLI call these across the library boundary
+
 namespace cmc33::io::detail {
 
 /// Calls write(stream) on a temporary file beside `path`, then renames it to `path`.
 /// If write throws, or the stream fails, the temporary file is removed and Error{io_error}
 /// (or write's own exception) propagates; `path` is left as it was.
 /// The temporary is `.NAME.tmpPID-N` in the target's folder (NAME the target's file name).
-void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
+CMC33_IO_EXPORT void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
 
 /// Lower-case extension with the dot (".ply"); "" if none.
-std::string lower_extension(const std::filesystem::path& path);
+CMC33_IO_EXPORT std::string lower_extension(const std::filesystem::path& path);
 
 /// A registered temporary file or folder: remove_temporaries() removes it (recursively) until
 /// it is committed or destroyed. Destroying it removes it too, unless it was committed.
-class Temporary {
+class CMC33_IO_EXPORT Temporary {
 public:
     /// Runs create() (which makes `path`: opens the file, creates the folder) under the
     /// registry's lock, then registers `path`. If create throws, nothing is registered.
@@ -57,13 +59,13 @@ private:
 /// Forks under the registry's lock, registers the child's process group (`child` runs in the
 /// forked child, must only call async-signal-safe functions and must not return: it puts
 /// itself in its own process group and execs). Returns the child's pid, -1 if fork failed.
-pid_t start_child(const std::function<void()>& child);
+CMC33_IO_EXPORT pid_t start_child(const std::function<void()>& child);
 /// The child has been waited for: its group is no longer killed by remove_temporaries().
-void forget_child(pid_t pid);
+CMC33_IO_EXPORT void forget_child(pid_t pid);
 
 /// Kills every registered process group (SIGKILL), removes every registered path, and keeps the
 /// registry locked so that nothing new is registered. For a thread that exits the process next.
 /// Returns the number of paths removed.
-int remove_temporaries() noexcept;
+CMC33_IO_EXPORT int remove_temporaries() noexcept;
 
 } // namespace cmc33::io::detail

@@ -12,7 +12,15 @@ function(run)
         message(FATAL_ERROR "failed (${rc}): ${line}")
     endif()
 endfunction()
-if(MODE STREQUAL "package")
+if(MODE STREQUAL "shared")
+    # the library built again as shared libraries (hidden symbols, the API exported), installed
+    run(${CMAKE_COMMAND} -S ${CMC33_SOURCE} -B ${WORK}/library -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+        -DBUILD_SHARED_LIBS=ON -DCMC33_BUILD_CLI=OFF -DCMC33_BUILD_TESTS=OFF)
+    run(${CMAKE_COMMAND} --build ${WORK}/library -j2)
+    run(${CMAKE_COMMAND} --install ${WORK}/library --prefix ${WORK}/prefix)
+    run(${CMAKE_COMMAND} -S ${SOURCE}/consumer -B ${WORK}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+        -DCMC33_CONSUME=package -DCMAKE_PREFIX_PATH=${WORK}/prefix)
+elseif(MODE STREQUAL "package")
     run(${CMAKE_COMMAND} --install ${CMC33_BUILD} --prefix ${WORK}/prefix)
     run(${CMAKE_COMMAND} -S ${SOURCE}/consumer -B ${WORK}/build -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
         -DCMC33_CONSUME=package -DCMAKE_PREFIX_PATH=${WORK}/prefix)

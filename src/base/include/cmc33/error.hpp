@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include "cmc33/base_export.hpp"
 
 namespace cmc33 {
 
@@ -21,7 +22,7 @@ enum class Status {
     internal,           ///< a broken invariant: a bug in cmc33
 };
 
-class Error : public std::runtime_error {
+class CMC33_BASE_EXPORT Error : public std::runtime_error {
 public:
     Error(Status status, const std::string& message) : std::runtime_error(message), status_(status) {}
     Status status() const noexcept { return status_; }

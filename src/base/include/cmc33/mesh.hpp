@@ -9,6 +9,7 @@
 #include <type_traits>
 #include <utility>
 #include <vector>
+#include "cmc33/base_export.hpp"
 
 namespace cmc33 {
 
@@ -16,8 +17,8 @@ namespace detail {
 /// Memory for Buffer: large blocks (4 MiB and more) are 2 MiB aligned and marked for transparent
 /// huge pages, so that filling a big mesh takes hundreds of times fewer page faults.
 /// @throws Error{too_large} "cannot allocate N bytes for the mesh (out of memory)"
-void* allocate_buffer(std::size_t bytes);
-void deallocate_buffer(void* p, std::size_t bytes) noexcept;
+CMC33_BASE_EXPORT void* allocate_buffer(std::size_t bytes);
+CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
 } // namespace detail
 
 /// std::allocator, except that resize(n) leaves new elements default-initialised (for float and

@@ -20,15 +20,16 @@
 #include <utility>
 
 #include "cmc33/error.hpp"
+#include "cmc33/base_export.hpp"
 
 namespace cmc33 {
 
 enum class ScalarType { i8, u8, i16, u16, i32, u32, f32, f64 };
 
 /// "int8", "uint8", "int16", "uint16", "int32", "uint32", "float", "double".
-std::string_view type_name(ScalarType type) noexcept;
+CMC33_BASE_EXPORT std::string_view type_name(ScalarType type) noexcept;
 /// Size of one sample in bytes.
-std::size_t type_size(ScalarType type) noexcept;
+CMC33_BASE_EXPORT std::size_t type_size(ScalarType type) noexcept;
 
 template <class T> constexpr ScalarType scalar_type_of();
 template <> constexpr ScalarType scalar_type_of<std::int8_t>() { return ScalarType::i8; }
@@ -95,7 +96,7 @@ template <class T> struct GridView {
 };
 
 /// Owns the samples of a volume read from a file or made by the caller.
-class Volume {
+class CMC33_BASE_EXPORT Volume {
 public:
     Volume() = default;
     /// Allocates zeroed samples. @throws Error{too_large} if the size overflows or an axis < 1.
@@ -182,9 +183,9 @@ struct NonFinite {
     std::int64_t count = 0;
     Index3 first{-1, -1, -1};
 };
-NonFinite find_non_finite(const Volume& volume);
+CMC33_BASE_EXPORT NonFinite find_non_finite(const Volume& volume);
 
 /// Smallest and largest sample (non-finite samples skipped).
-std::pair<double, double> value_range(const Volume& volume);
+CMC33_BASE_EXPORT std::pair<double, double> value_range(const Volume& volume);
 
 } // namespace cmc33

@@ -7,6 +7,7 @@
 
 #include "cmc33/extract.hpp"
 #include "cmc33/mesh.hpp"
+#include "cmc33/core_export.hpp"
 
 namespace cmc33 {
 
@@ -48,6 +49,6 @@ struct CellReport {
 /// Classifies and triangulates one cell exactly as extract() does.
 /// @param values  corner values, corner c at (c & 1, c >> 1 & 1, c >> 2 & 1)
 /// @throws Error{non_finite} for a NaN or infinite value or iso
-CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method method = Method::cmc33);
+CMC33_CORE_EXPORT CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method method = Method::cmc33);
 
 } // namespace cmc33

@@ -11,6 +11,7 @@
 
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
+#include "cmc33/core_export.hpp"
 
 namespace cmc33 {
 
@@ -20,15 +21,15 @@ enum class Method {
     mc,           ///< classic Marching Cubes: one triangulation per sign configuration
 };
 
-std::string_view method_name(Method method) noexcept; ///< "cmc33", "mc33-lewiner", "mc"
+CMC33_CORE_EXPORT std::string_view method_name(Method method) noexcept; ///< "cmc33", "mc33-lewiner", "mc"
 /// @throws Error{invalid_argument} naming the accepted names.
-Method parse_method(std::string_view name);
+CMC33_CORE_EXPORT Method parse_method(std::string_view name);
 
 /// Subcases of Chernyaev's table, numbered 0..32 in the order
 /// 0, 1, 2, 3.1, 3.2, 4.1.1, 4.1.2, 5, 6.1.1, 6.1.2, 6.2, 7.1, 7.2, 7.3, 7.4.1, 7.4.2, 8, 9,
 /// 10.1.1, 10.1.2, 10.2, 11, 12.1.1, 12.1.2, 12.2, 12.3, 13.1, 13.2, 13.3, 13.4, 13.5.1, 13.5.2, 14.
 inline constexpr int kSubcaseCount = 33;
-std::string_view subcase_name(int subcase) noexcept;
+CMC33_CORE_EXPORT std::string_view subcase_name(int subcase) noexcept;
 
 /// Runs task(0), ..., task(n - 1), possibly at the same time, and returns when all have returned.
 /// If tasks throw, it rethrows one of their exceptions after all have ended. The default
@@ -67,7 +68,7 @@ struct ExtractStats {
 /// Cost: O(cells) time; working memory O(slices); no allocation inside a pass.
 /// The composition of the passes of passes.hpp over `threads` ranges of sample planes.
 template <class T>
-Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
-Mesh extract(const Volume& volume, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
+CMC33_CORE_EXPORT Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
+CMC33_CORE_EXPORT Mesh extract(const Volume& volume, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
 
 } // namespace cmc33

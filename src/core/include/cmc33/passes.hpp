@@ -34,6 +34,7 @@
 
 #include "cmc33/extract.hpp"
 #include "cmc33/volume.hpp"
+#include "cmc33/core_export.hpp"
 
 namespace cmc33 {
 
@@ -100,10 +101,10 @@ struct MeshSpans {
 /// ranges in parallel for threads (options.threads, progress and executor are not used here).
 /// @throws Error{invalid_argument} unless 0 <= k0 < k1 <= nz, or for the grid errors of extract()
 template <class T>
-RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1);
+CMC33_CORE_EXPORT RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1);
 
 /// Pass 2: consecutive offsets for ranges in order, starting at the given ids.
-std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex = 0,
+CMC33_CORE_EXPORT std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex = 0,
                                std::int64_t first_triangle = 0);
 
 /// Pass 3: writes the range's vertices (positions, and normals etc. where `out` has arrays for them)
@@ -113,7 +114,7 @@ std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t
 /// @throws Error{internal} if the cells decided differently than in count() (a bug); Error{too_large}
 ///         if a vertex id passes 2^32 - 2
 template <class T>
-void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
+CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out);
 
 } // namespace cmc33

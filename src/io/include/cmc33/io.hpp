@@ -21,6 +21,7 @@
 
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
+#include "cmc33/io_export.hpp"
 
 namespace cmc33::io {
 
@@ -37,16 +38,16 @@ struct RawOptions {
 
 /// Parses "int8|uint8|int16|uint16|int32|uint32|float|double" (also "char", "uchar", "short",
 /// "ushort", "int", "uint", "float32", "float64"). @throws Error{invalid_argument}.
-ScalarType parse_type(const std::string& name);
+CMC33_IO_EXPORT ScalarType parse_type(const std::string& name);
 
 /// Reads a volume; `raw` is required for headerless files and ignored otherwise.
 /// Samples are converted to the machine's byte order.
 /// @throws Error (io_error, truncated_file, bad_format, unsupported_format, too_large)
-Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw = std::nullopt);
+CMC33_IO_EXPORT Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw = std::nullopt);
 
 /// Writes a volume: .nrrd (attached, raw), .nhdr (+ .raw beside it), .mhd (+ .raw), .mha,
 /// .vtk (binary, big-endian), .raw (headerless, machine order). @throws Error.
-void write_volume(const Volume& volume, const std::filesystem::path& path);
+CMC33_IO_EXPORT void write_volume(const Volume& volume, const std::filesystem::path& path);
 
 struct MeshWriteOptions {
     bool ascii = false; ///< PLY only: ASCII instead of binary little-endian
@@ -54,12 +55,12 @@ struct MeshWriteOptions {
 
 /// Writes .ply, .obj, .stl (binary) or .off. Normals are written where the format carries them
 /// (PLY, OBJ). @throws Error{unsupported_format} for another extension, Error{io_error}.
-void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
+CMC33_IO_EXPORT void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
 
 /// Reads .ply (ASCII or binary, either endian), .obj, .stl (binary or ASCII) or .off. Polygons
 /// with more than three vertices are fanned. STL has no indices: exactly coincident vertices are
 /// welded. @throws Error.
-Mesh read_mesh(const std::filesystem::path& path);
+CMC33_IO_EXPORT Mesh read_mesh(const std::filesystem::path& path);
 
 /// A volume format, for bytes that have no file name to tell it.
 enum class VolumeFormat {
@@ -85,7 +86,7 @@ using MemoryFiles = std::function<std::optional<std::string_view>(std::string_vi
 ///     };
 ///     Volume v = io::read_volume_from_memory(nhdr_text, io::VolumeFormat::nrrd, "ct.nhdr",
 ///                                            std::nullopt, files);
-Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format, const std::string& label,
+CMC33_IO_EXPORT Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format, const std::string& label,
                                const std::optional<RawOptions>& raw = std::nullopt,
                                const MemoryFiles& data_files = {});
 
@@ -95,9 +96,9 @@ enum class MeshFormat { ply, obj, stl, off };
 /// Reads a mesh from bytes in memory, exactly as read_mesh() reads a file of that format (which
 /// calls this). `label` stands for the file's name at the start of every message.
 /// @throws Error, as read_mesh(); never another exception type, whatever the bytes.
-Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& label);
+CMC33_IO_EXPORT Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& label);
 
 /// True for names whose extension read_volume() knows without RawOptions.
-bool has_volume_header(const std::filesystem::path& path);
+CMC33_IO_EXPORT bool has_volume_header(const std::filesystem::path& path);
 
 } // namespace cmc33::io

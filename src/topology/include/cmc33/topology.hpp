@@ -10,6 +10,7 @@
 
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
+#include "cmc33/topology_export.hpp"
 
 namespace cmc33 {
 
@@ -36,7 +37,7 @@ struct MeshTopology {
 /// @throws Error{invalid_argument} if an index is not below the vertex count or the triangle array
 /// is not a multiple of 3.
 /// Cost: O(F) time and about 24 bytes per triangle of working memory.
-MeshTopology mesh_topology(const Mesh& mesh);
+CMC33_TOPOLOGY_EXPORT MeshTopology mesh_topology(const Mesh& mesh);
 
 /// The mesh as it sits in space. Positions are compared exactly (the floats of the mesh), and
 /// every test is an exact predicate, so nothing here depends on a tolerance.
@@ -68,7 +69,7 @@ struct MeshGeometryOptions {
 /// Cost: O(F log F) time (a sort of triangles into buckets of a uniform grid sized by the mean
 /// triangle, then exact tests of the pairs whose boxes overlap); memory about 40 bytes per
 /// triangle. A 2-million-triangle surface takes about a second.
-MeshGeometry mesh_geometry(const Mesh& mesh, const MeshGeometryOptions& options = {});
+CMC33_TOPOLOGY_EXPORT MeshGeometry mesh_geometry(const Mesh& mesh, const MeshGeometryOptions& options = {});
 
 /// Invariants of S = {x : f(x) = iso} inside the grid's box, f the piecewise-trilinear
 /// interpolant of the samples, computed from the samples alone (no mesh, nothing shared with the
@@ -96,7 +97,7 @@ struct FieldTopologyOptions {
 };
 
 template <class T>
-FieldTopology field_topology(const GridView<T>& grid, double iso, const FieldTopologyOptions& options = {});
-FieldTopology field_topology(const Volume& volume, double iso, const FieldTopologyOptions& options = {});
+CMC33_TOPOLOGY_EXPORT FieldTopology field_topology(const GridView<T>& grid, double iso, const FieldTopologyOptions& options = {});
+CMC33_TOPOLOGY_EXPORT FieldTopology field_topology(const Volume& volume, double iso, const FieldTopologyOptions& options = {});
 
 } // namespace cmc33

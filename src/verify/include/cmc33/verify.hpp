@@ -17,6 +17,7 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/volume.hpp"
+#include "cmc33/verify_export.hpp"
 
 namespace cmc33 {
 
@@ -33,26 +34,26 @@ namespace cmc33 {
 enum class FieldKind { cell, grid, closed, ties };
 inline constexpr int kFieldKindCount = 4;
 
-std::string_view field_kind_name(FieldKind kind) noexcept; ///< "cell", "grid", "closed", "ties"
+CMC33_VERIFY_EXPORT std::string_view field_kind_name(FieldKind kind) noexcept; ///< "cell", "grid", "closed", "ties"
 
 /// Item n (n >= 1) of kind `kind` in a run with seed `seed`: float samples, spacing 1, origin 0.
 /// Each item has its own generator, seeded from (seed, kind, n) (SplitMix64), so a field does not
 /// depend on the thread count, the order of work or the other items of the run.
 /// @param size  samples per axis of grid and closed fields (ignored for cells)
 /// @throws Error{invalid_argument} if n < 1 or size < 2 (size < 3 for closed: no interior sample)
-Volume random_field(FieldKind kind, std::int64_t n, std::uint64_t seed, int size = 5);
+CMC33_VERIFY_EXPORT Volume random_field(FieldKind kind, std::int64_t n, std::uint64_t seed, int size = 5);
 
 /// Name of the distribution cell n is drawn from ("uniform", "cubed", "pattern", ...).
-std::string_view cell_distribution_name(std::int64_t n) noexcept;
+CMC33_VERIFY_EXPORT std::string_view cell_distribution_name(std::int64_t n) noexcept;
 
 /// "cell-000042": the file stem of item n (six digits at least).
-std::string field_name(FieldKind kind, std::int64_t n);
+CMC33_VERIFY_EXPORT std::string field_name(FieldKind kind, std::int64_t n);
 
 /// True iff the mesh has the field's euler, b0, b1, b2 and boundary loops. False if the field is
 /// undetermined. Manifoldness is not part of it: see is_manifold().
-bool topology_matches(const MeshTopology& mesh, const FieldTopology& field) noexcept;
+CMC33_VERIFY_EXPORT bool topology_matches(const MeshTopology& mesh, const FieldTopology& field) noexcept;
 /// No non-manifold edge and no non-manifold vertex.
-bool is_manifold(const MeshTopology& mesh) noexcept;
+CMC33_VERIFY_EXPORT bool is_manifold(const MeshTopology& mesh) noexcept;
 
 /// Where a long run is, for a progress line. Called on the thread that called verify(),
 /// about every 0.2 s, and once more at the end with done == total.
@@ -107,7 +108,7 @@ struct MethodReport {
     std::string first_error;
 };
 
-struct VerifyReport {
+struct CMC33_VERIFY_EXPORT VerifyReport {
     std::vector<MethodReport> methods;
     std::array<std::int64_t, kFieldKindCount> fields{}; ///< fields run, per kind
     std::array<double, kFieldKindCount> kind_seconds{}; ///< wall time per kind
@@ -134,7 +135,7 @@ struct VerifyReport {
 /// the failure).
 /// @throws Error{invalid_argument} for a negative count, size < 2 (< 3 with closed fields), no
 ///         method, or a repeated method; Error from the writers.
-VerifyReport verify(const VerifyOptions& options);
+CMC33_VERIFY_EXPORT VerifyReport verify(const VerifyOptions& options);
 
 // ------------------------------------------------------------------------------------------------
 // The public dataset.
@@ -165,7 +166,7 @@ struct DatasetSummary {
 /// into place at the end: on an error nothing is left (and `dir` is removed if it was created).
 /// @throws Error{invalid_argument} if dir is empty (""), not a folder or holds other files, for a
 ///         negative count or a bad size; Error{io_error} from the writers.
-DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options);
+CMC33_VERIFY_EXPORT DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOptions& options);
 
 /// One line of manifest.tsv.
 struct ManifestEntry {
@@ -178,7 +179,7 @@ struct ManifestEntry {
 
 /// Reads `dir/manifest.tsv`. @throws Error{io_error} if it cannot be read, Error{bad_format}
 /// naming the file and the line for a line that does not parse.
-std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir);
+CMC33_VERIFY_EXPORT std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir);
 
 struct DatasetVerifyOptions {
     std::vector<Method> methods{Method::cmc33}; ///< in-process extractors, if command is empty
@@ -203,7 +204,7 @@ struct DatasetVerifyOptions {
 /// (a 2x2x2 field is a cell), under the method, or under cmc33 for a command. Kinds: a file named
 /// cell-* or with a subcase is a cell, closed-* a closed grid, anything else a grid.
 /// @throws Error from read_manifest and read_volume (a missing or broken dataset file).
-VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerifyOptions& options);
+CMC33_VERIFY_EXPORT VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerifyOptions& options);
 
 /// A command line for one field, and the mesh file it writes.
 struct ExternalCommand {
@@ -214,7 +215,7 @@ struct ExternalCommand {
 /// The template with {in}, {iso} and {out} replaced, every occurrence, paths single-quoted.
 /// {out} is `out_base` + ".ply", or `out_base` alone where the template writes ".ply", ".obj",
 /// ".off" or ".stl" right after it. @throws Error{invalid_argument} if {in} or {out} is missing.
-ExternalCommand expand_command(std::string_view command_template, const std::filesystem::path& in,
+CMC33_VERIFY_EXPORT ExternalCommand expand_command(std::string_view command_template, const std::filesystem::path& in,
                                double iso, const std::filesystem::path& out_base);
 
 } // namespace cmc33
