@@ -100,8 +100,8 @@ void expect_same_mesh(const cmc33::Mesh& m, const Output& o, const std::string& 
     EXPECT_TRUE(same) << what << ": triangles differ";
 }
 
-/// Splits of nz planes: one range, three uneven ones, one plane each, and the two-range splits
-/// at every plane boundary.
+/// Splits of nz planes: one range, three uneven ones, one plane each, the two-range splits at
+/// every plane boundary, and seven uneven ones.
 std::vector<std::vector<std::int64_t>> splits(std::int64_t nz)
 {
     std::vector<std::vector<std::int64_t>> s = {{0, nz}, {0, 1, nz / 3 + 1, nz}};
@@ -109,6 +109,12 @@ std::vector<std::vector<std::int64_t>> splits(std::int64_t nz)
     for (std::int64_t k = 0; k <= nz; ++k) each.push_back(k);
     s.push_back(each);
     for (std::int64_t k = 1; k < nz; ++k) s.push_back({0, k, nz});
+    if (nz >= 8) {
+        std::vector<std::int64_t> seven = {0}; // seven uneven ranges, short ones first
+        for (std::int64_t r = 1; r < 7; ++r) seven.push_back(std::max(seven.back() + 1, nz * r * r / 49));
+        seven.push_back(nz);
+        s.push_back(seven);
+    }
     return s;
 }
 
