@@ -22,6 +22,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/topology.hpp"
 #include "exact_geometry.hpp"
+#include "parallel.hpp"
 
 namespace cmc33 {
 namespace {
@@ -49,35 +50,11 @@ constexpr int kKeyBits = 21;
 constexpr std::int64_t kCellsPerAxis = std::int64_t{1} << kKeyBits;
 constexpr std::int64_t kMaxCells = 512; ///< a triangle spanning more cells goes to a coarser level
 
-template <class Body> void parallel_for(std::int64_t n, int threads, Body&& body)
-{
-    threads = static_cast<int>(std::max<std::int64_t>(1, std::min<std::int64_t>(threads, n)));
-    if (threads == 1) {
-        body(0, std::int64_t{0}, n);
-        return;
-    }
-    std::vector<std::thread> pool;
-    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(threads));
-    for (int t = 0; t < threads; ++t) {
-        pool.emplace_back([&, t] {
-            try {
-                body(t, n * t / threads, n * (t + 1) / threads);
-            } catch (...) {
-                errors[static_cast<std::size_t>(t)] = std::current_exception();
-            }
-        });
-    }
-    for (auto& th : pool) th.join();
-    for (auto& e : errors)
-        if (e) std::rethrow_exception(e);
-}
-
 class GeometryCheck {
 public:
     GeometryCheck(const Mesh& mesh, const MeshGeometryOptions& options) : mesh_(mesh), options_(options)
     {
-        const unsigned hw = std::thread::hardware_concurrency();
-        threads_ = options.threads > 0 ? options.threads : static_cast<int>(hw == 0 ? 1 : hw);
+        threads_ = detail::resolve_threads(options.threads);
     }
 
     MeshGeometry run()
@@ -163,7 +140,7 @@ private:
         const std::size_t count = mesh_.triangle_count();
         proper_.assign(count, 0);
         std::vector<std::int64_t> zero(static_cast<std::size_t>(threads_), 0);
-        parallel_for(static_cast<std::int64_t>(count), threads_, [&](int th, std::int64_t t0, std::int64_t t1) {
+        detail::parallel_chunks(static_cast<std::int64_t>(count), threads_, [&](int th, std::int64_t t0, std::int64_t t1) {
             for (std::int64_t t = t0; t < t1; ++t) {
                 const auto c = corners(static_cast<std::size_t>(t));
                 const bool degenerate = c[0] == c[1] || c[1] == c[2] || c[0] == c[2] ||
@@ -320,7 +297,7 @@ private:
         const auto group_count = static_cast<std::int64_t>(groups_.size() - 1);
         found_.resize(static_cast<std::size_t>(threads_), 0);
         examples_.resize(static_cast<std::size_t>(threads_));
-        parallel_for(group_count, threads_, [&](int th, std::int64_t g0, std::int64_t g1) {
+        detail::parallel_chunks(group_count, threads_, [&](int th, std::int64_t g0, std::int64_t g1) {
             auto& mine = examples_[static_cast<std::size_t>(th)];
             std::vector<std::uint32_t> top, all;
             for (std::int64_t g = g0; g < g1; ++g) {
