@@ -41,6 +41,7 @@
 #include "decide.hpp"
 #include "parallel.hpp"
 #include "placement.hpp"
+#include "portability.hpp"
 #include "mc33_tables.hpp"
 
 namespace cmc33 {
@@ -435,7 +436,7 @@ private:
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
 
     /// Above-flags of the samples of row (j, k), and the row's kind (SliceFlags).
-    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
+    CMC33_ALWAYS_INLINE const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
     {
         bool fresh = false;
         std::uint8_t* known = nullptr;
@@ -474,7 +475,7 @@ private:
     /// where the edge does not cross or does not exist (or, in the next range's plane k1, for the z
     /// edges, which no cell of this range uses). `interior`: the id after the row's last z edge
     /// vertex, where the interior vertices of its cells begin.
-    const std::uint32_t* row_ids(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& interior) const
+    CMC33_ALWAYS_INLINE const std::uint32_t* row_ids(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& interior) const
     {
         bool fresh = false;
         std::int64_t* end = nullptr;
@@ -547,7 +548,7 @@ private:
 
     /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
     /// vertices in z_first, triangles in triangle_first (count() turns them into first ids).
-    void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c) const
+    CMC33_ALWAYS_INLINE void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c) const
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
