@@ -337,10 +337,17 @@ public:
         }
         // the rows hold their counts; turn them into first ids (the numbering of passes.hpp)
         std::int64_t v = 0, t = 0;
+        const auto first_id = [&v, k0, k1](std::uint32_t& count) {
+            if (v >= static_cast<std::int64_t>(kNoVertex)) {
+                throw Error(Status::too_large, "sample planes " + std::to_string(k0) + " to " + std::to_string(k1) +
+                                                   " would have more vertices than 32-bit indices can address");
+            }
+            v += std::exchange(count, static_cast<std::uint32_t>(v));
+        };
         for (std::int64_t k = k0; k < k1; ++k) {
             RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - k0) * ny_)];
-            for (std::int64_t j = 0; j < ny_; ++j) v += std::exchange(plane[j].xy_first, v);
-            for (std::int64_t j = 0; j < ny_; ++j) v += std::exchange(plane[j].z_first, v);
+            for (std::int64_t j = 0; j < ny_; ++j) first_id(plane[j].xy_first);
+            for (std::int64_t j = 0; j < ny_; ++j) first_id(plane[j].z_first);
             for (std::int64_t j = 0; j < ny_; ++j) t += std::exchange(plane[j].triangle_first, t);
         }
         c.vertices_ = v, c.triangles_ = t;
@@ -515,10 +522,15 @@ private:
         auto z = static_cast<std::uint32_t>(e.off.first_vertex + r.z0);
         // outside the trim range no edge crosses: those slots are never read for a vertex
         for (std::int64_t i = r.lo; i < r.hi; ++i) {
+            // branch-free (selects, not jumps): crossings are unpredictable on rough surfaces
             const unsigned crossed = crossed_edges(f, fy, fz, i, nx_);
-            ids[3 * i] = crossed & 1u ? xy++ : kNoVertex;
-            ids[3 * i + 1] = crossed & 2u ? xy++ : kNoVertex;
-            ids[3 * i + 2] = crossed & 4u ? z++ : kNoVertex;
+            const unsigned cx = crossed & 1u, cy = (crossed >> 1) & 1u, cz = crossed >> 2;
+            ids[3 * i] = cx ? xy : kNoVertex;
+            xy += cx;
+            ids[3 * i + 1] = cy ? xy : kNoVertex;
+            xy += cy;
+            ids[3 * i + 2] = cz ? z : kNoVertex;
+            z += cz;
         }
         if (xy != e.off.first_vertex + r.xy1) throw_mismatch("x/y edge vertices", j, k);
         if (z > e.off.first_vertex + r.v1) throw_mismatch("z edge vertices", j, k);
@@ -588,7 +600,7 @@ private:
         }
         if (hi > lo) row.lo = static_cast<std::int32_t>(lo), row.hi = static_cast<std::int32_t>(hi);
         row.xy_first = xy;
-        row.z_first = z + interior;
+        row.z_first = static_cast<std::uint32_t>(z + interior); // < 16 nx < 2^32 (check_grid)
         row.triangle_first = triangles;
     }
 
@@ -890,8 +902,9 @@ template <class T> void check_grid(const GridView<T>& g, double iso)
                       static_cast<double>(std::numeric_limits<float>::max()));
         throw Error(Status::too_large, text);
     }
-    // a row's crossed-edge count (up to 3 nx) is summed in 32 bits, which keeps that loop vectorised
-    constexpr std::int64_t kMaxRow = std::numeric_limits<std::uint32_t>::max() / 3;
+    // a row's vertex count (3 nx edge vertices + at most 12 interior ones per cell) is kept in 32
+    // bits, which keeps the counting loops vectorised and RangeCounts at 24 bytes a row
+    constexpr std::int64_t kMaxRow = std::numeric_limits<std::uint32_t>::max() / 16;
     if (g.nx() > kMaxRow) {
         throw Error(Status::too_large, "grid has " + std::to_string(g.nx()) + " samples along x; the extractor handles at most " +
                                            std::to_string(kMaxRow) + " per row");

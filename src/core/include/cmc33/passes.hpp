@@ -39,7 +39,7 @@
 namespace cmc33 {
 
 /// What count() found in one range: the number of vertices and triangles, and per sample row the
-/// numbers emit() needs to place them. Opaque apart from the accessors; O(ny * (k1 - k0)) memory.
+/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row.
 class RangeCounts {
 public:
     std::int64_t k0() const noexcept { return k0_; }
@@ -51,10 +51,10 @@ public:
 
 private:
     template <class T> friend class RangeExtractor;
-    struct Row {
-        std::int64_t xy_first = 0;  ///< first id of the row's x/y edge vertices (range-relative)
-        std::int64_t z_first = 0;   ///< first id of its z edge vertices, then its cells' interior ones
+    struct Row { // 24 bytes: vertex ids fit 32 bits (a range's count is checked), triangles may not
         std::int64_t triangle_first = 0;
+        std::uint32_t xy_first = 0; ///< first id of the row's x/y edge vertices (range-relative)
+        std::uint32_t z_first = 0;  ///< first id of its z edge vertices, then its cells' interior ones
         std::int32_t lo = 0, hi = 0; ///< samples [lo, hi) own every crossed edge and cell of the row
     };
     std::int64_t k0_ = 0, k1_ = 0, nx_ = 0, ny_ = 0;
