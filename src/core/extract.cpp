@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -37,6 +38,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/passes.hpp"
+#include "classify.hpp"
 #include "cube.hpp"
 #include "decide.hpp"
 #include "parallel.hpp"
@@ -49,96 +51,61 @@ namespace {
 
 using detail::kEdgeCorners;
 
-/// The sign rule for samples of type T: v >= iso. Integer samples are compared in their own type
-/// against ceil(iso) (exact, and cheap in the hot loop); floating-point samples in double.
-template <class T> class Above {
-public:
-    explicit Above(double iso) : iso_(iso)
-    {
-        if constexpr (std::is_integral_v<T>) {
-            const double t = std::ceil(iso);
-            if (t <= static_cast<double>(std::numeric_limits<T>::lowest())) {
-                mode_ = Mode::all;
-            } else if (t > static_cast<double>(std::numeric_limits<T>::max())) {
-                mode_ = Mode::none;
-            } else {
-                threshold_ = static_cast<T>(t);
-            }
-        }
-    }
-    /// flags[i] = 1 if row[i * stride] is above, else 0.
-    void row(const T* row, std::int64_t n, std::int64_t stride, std::uint8_t* flags) const
-    {
-        if constexpr (std::is_integral_v<T>) {
-            if (mode_ != Mode::compare) {
-                std::memset(flags, mode_ == Mode::all ? 1 : 0, static_cast<std::size_t>(n));
-                return;
-            }
-            const T t = threshold_;
-            if (stride == 1) {
-                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i] >= t);
-            } else {
-                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(row[i * stride] >= t);
-            }
-        } else {
-            const double iso = iso_;
-            if (stride == 1) {
-                for (std::int64_t i = 0; i < n; ++i) flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i]) >= iso);
-            } else {
-                for (std::int64_t i = 0; i < n; ++i)
-                    flags[i] = static_cast<std::uint8_t>(static_cast<double>(row[i * stride]) >= iso);
-            }
-        }
-    }
-
-private:
-    enum class Mode { compare, all, none };
-    double iso_;
-    Mode mode_ = Mode::compare;
-    T threshold_{};
-};
-
 constexpr std::int64_t kCornerOffset[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
                                               {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
 
-/// A column code holds the above-flags of the four samples (i, j, k), (i, j+1, k), (i, j, k+1),
-/// (i, j+1, k+1) in bits 0..3. Two neighbouring columns make a cell:
-/// kCellCode[col(i) | col(i+1) << 4] is the cell's case code (bit c: corner c above).
-constexpr std::array<std::uint8_t, 256> kCellCode = [] {
-    std::array<std::uint8_t, 256> table{};
-    for (unsigned pair = 0; pair < 256; ++pair) {
-        unsigned code = 0;
-        for (unsigned c = 0; c < 8; ++c) code |= ((pair >> (4 * (c & 1u) + (c >> 1))) & 1u) << c;
-        table[pair] = static_cast<std::uint8_t>(code);
+/// For each cell edge: which of the four sample rows around a cell row owns it (bit 0: j + 1, bit
+/// 1: k + 1, the index into the ids of those rows), and its slot there relative to 3 * i (3 * x
+/// offset + axis).
+constexpr std::array<std::uint8_t, 12> kEdgeRow = [] {
+    std::array<std::uint8_t, 12> r{};
+    for (int q = 0; q < 12; ++q) {
+        const int c = kEdgeCorners[q][0];
+        r[static_cast<std::size_t>(q)] = static_cast<std::uint8_t>(kCornerOffset[c][1] + 2 * kCornerOffset[c][2]);
     }
-    return table;
+    return r;
+}();
+constexpr std::array<std::uint8_t, 12> kEdgeSlot = [] {
+    std::array<std::uint8_t, 12> s{};
+    for (int q = 0; q < 12; ++q) {
+        s[static_cast<std::size_t>(q)] = static_cast<std::uint8_t>(3 * kCornerOffset[kEdgeCorners[q][0]][0] + q / 4);
+    }
+    return s;
 }();
 
-/// Above-flags of sample rows, filled row by row on demand, for three consecutive slices at once
-/// (slice k lives in buffer k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at most.
-/// Each row is computed once per thread, with its kind: kBelow or kAbove when every sample of it
-/// is, else kMixed.
-class SliceFlags {
+/// A row's above-flags as 64-bit words (classify.hpp), with one zero word after the last so that
+/// "the flag of sample i + 1" can read one word past any sample's.
+using Word = std::uint64_t;
+
+/// Word w of the row shifted down by one sample: bit b is the flag of sample 64 w + b + 1.
+CMC33_ALWAYS_INLINE Word next_sample(const Word* m, std::int64_t w) { return m[w] >> 1 | m[w + 1] << 63; }
+
+/// The above-flags of sample rows, classified row by row on demand, for three consecutive slices
+/// at once (slice k lives in buffer k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at
+/// most. Each row is classified once per thread, with its kind: kBelow or kAbove when every sample
+/// of it is, else kMixed.
+class SliceMasks {
 public:
-    SliceFlags(std::int64_t nx, std::int64_t ny)
-        : nx_(nx), ny_(ny), flags_(static_cast<std::size_t>(3 * nx * ny)),
+    SliceMasks(std::int64_t nx, std::int64_t ny)
+        : words_((nx + 63) / 64), stride_(words_ + 1), ny_(ny), bits_(static_cast<std::size_t>(3 * ny * stride_), 0),
           slice_of_(static_cast<std::size_t>(3 * ny), -1), kind_(static_cast<std::size_t>(3 * ny), 0)
     {
     }
-    /// The flags of row (j, k); `fresh` when they must be computed (then also set `kind`).
-    std::uint8_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::uint8_t*& kind)
+    /// The words of row (j, k); `fresh` when they must be computed (then also set `kind`).
+    CMC33_ALWAYS_INLINE Word* get(std::int64_t j, std::int64_t k, bool& fresh, std::uint8_t*& kind)
     {
         const auto row = static_cast<std::size_t>((k % 3) * ny_ + j);
         fresh = slice_of_[row] != k;
         slice_of_[row] = k;
         kind = &kind_[row];
-        return &flags_[row * static_cast<std::size_t>(nx_)];
+        return &bits_[row * static_cast<std::size_t>(stride_)];
     }
+    std::int64_t words() const { return words_; }
     static constexpr std::uint8_t kBelow = 0, kAbove = 1, kMixed = 2;
 
 private:
-    std::int64_t nx_, ny_;
-    std::vector<std::uint8_t> flags_;
+    std::int64_t words_, stride_, ny_;
+    std::vector<Word> bits_;
     std::vector<std::int64_t> slice_of_;
     std::vector<std::uint8_t> kind_;
 };
@@ -146,7 +113,7 @@ private:
 /// Vertex ids of the edges owned by four sample rows, one slot per parity of (j, k): a cell row
 /// (j, k) reads rows j..j+1 of slices k..k+1, which never share a slot, and the next cell row
 /// along j finds two of them already filled. Each slot also keeps where its row's interior
-/// vertices start.
+/// vertices start. Only the slots of crossed edges are written (and read).
 class IdRows {
 public:
     explicit IdRows(std::int64_t nx) : ids_(4 * 3 * static_cast<std::size_t>(nx)), len_(3 * static_cast<std::size_t>(nx)) {}
@@ -167,14 +134,48 @@ private:
     std::int64_t interior_start_[4] = {};
 };
 
-/// Bits 0..2: which of the x, y, z edges owned by sample i of a row cross, from the above-flags of
-/// the row (f), of the row at j + 1 (fy) and of the row at k + 1 (fz). At the grid's last row or
-/// slice pass f itself for fy or fz: those edges do not exist and never cross.
-inline unsigned crossed_edges(const std::uint8_t* f, const std::uint8_t* fy, const std::uint8_t* fz, std::int64_t i,
-                              std::int64_t nx)
+/// The edges owned by the samples of one word of a sample row that cross: x (from the row's flags
+/// f), y (against the row at j + 1, fy) and z (against the row at k + 1, fz). At the grid's last
+/// row or slice pass f itself for fy or fz: those edges do not exist and never cross. `x_valid`
+/// clears the x edge of the row's last sample, which does not exist either.
+struct EdgeWords {
+    Word x, y, z;
+    CMC33_ALWAYS_INLINE EdgeWords(const Word* f, const Word* fy, const Word* fz, std::int64_t w, Word x_valid)
+        : x((f[w] ^ next_sample(f, w)) & x_valid), y(f[w] ^ fy[w]), z(f[w] ^ fz[w])
+    {
+    }
+    Word any() const { return x | y | z; }
+};
+
+/// The crossed cells of one word of a cell row, from the flags of its four sample rows a (j, k),
+/// b (j + 1, k), c (j, k + 1), d (j + 1, k + 1): a cell is crossed unless its 8 corners agree.
+CMC33_ALWAYS_INLINE Word crossed_cells(const Word* a, const Word* b, const Word* c, const Word* d, std::int64_t w,
+                                       Word cell_valid)
 {
-    return static_cast<unsigned>(i + 1 < nx && f[i] != f[i + 1]) | static_cast<unsigned>(f[i] != fy[i]) << 1 |
-           static_cast<unsigned>(f[i] != fz[i]) << 2;
+    const Word any = a[w] | b[w] | c[w] | d[w], all = a[w] & b[w] & c[w] & d[w];
+    const Word any_next = (any >> 1) | (a[w + 1] | b[w + 1] | c[w + 1] | d[w + 1]) << 63;
+    const Word all_next = (all >> 1) | (a[w + 1] & b[w + 1] & c[w + 1] & d[w + 1]) << 63;
+    return (any | any_next) & ~(all & all_next) & cell_valid;
+}
+
+/// The case code (bit c: corner c above, corner order of cube.hpp) of the cell at bit s of word w.
+CMC33_ALWAYS_INLINE unsigned cell_code(const Word* a, const Word* b, const Word* c, const Word* d, std::int64_t w, int s)
+{
+    const auto two = [w, s](const Word* m) {
+        return static_cast<unsigned>(((m[w] >> s) | ((m[w + 1] << 1) << (63 - s))) & 3u);
+    };
+    return two(a) | two(b) << 2 | two(c) << 4 | two(d) << 6;
+}
+
+/// Words of valid bits: sample bits (below nx) or cell and x edge bits (below nx - 1).
+std::vector<Word> valid_words(std::int64_t words, std::int64_t bits)
+{
+    std::vector<Word> v(static_cast<std::size_t>(words), 0);
+    for (std::int64_t w = 0; w < words; ++w) {
+        const std::int64_t n = std::clamp<std::int64_t>(bits - 64 * w, 0, 64);
+        v[static_cast<std::size_t>(w)] = n == 64 ? ~Word{0} : (Word{1} << n) - 1;
+    }
+    return v;
 }
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
@@ -195,15 +196,31 @@ template <class T> double largest_coordinate(const GridView<T>& g)
     return largest;
 }
 
-/// x and y edges owned by a sample row that cross: from its above-flags (f) and those of the row
-/// at j + 1 (fy; pass f at the last row, whose y edges do not exist).
-inline std::uint32_t xy_crossings(const std::uint8_t* f, const std::uint8_t* fy, std::int64_t nx)
+/// The largest |sample| of planes [k_lo, k_hi] (for integer types, the type's bound).
+/// @throws Error{non_finite} for NaN or infinite samples there, saying how many and the first
+template <class T> double scan_samples(const GridView<T>& g, std::int64_t k_lo, std::int64_t k_hi)
 {
-    // flags are 0 or 1, so != is ^ and the narrow sums vectorise
-    std::uint32_t n = 0;
-    for (std::int64_t i = 0; i + 1 < nx; ++i) n += static_cast<std::uint32_t>(f[i] ^ f[i + 1]);
-    for (std::int64_t i = 0; i < nx; ++i) n += static_cast<std::uint32_t>(f[i] ^ fy[i]);
-    return n;
+    if constexpr (std::is_floating_point_v<T>) {
+        double largest = 0;
+        std::int64_t count = 0;
+        Index3 first{-1, -1, -1};
+        for (std::int64_t k = k_lo; k <= k_hi; ++k)
+            for (std::int64_t j = 0; j < g.ny(); ++j)
+                for (std::int64_t i = 0; i < g.nx(); ++i) {
+                    const double v = std::fabs(static_cast<double>(g(i, j, k)));
+                    if (!std::isfinite(v) && count++ == 0) first = {i, j, k};
+                    largest = std::max(largest, v);
+                }
+        if (count > 0) {
+            throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
+                                                std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
+                                                std::to_string(first[2]) + "); cmc33 needs finite samples");
+        }
+        return largest;
+    } else {
+        return std::max(std::fabs(static_cast<double>(std::numeric_limits<T>::lowest())),
+                        static_cast<double>(std::numeric_limits<T>::max()));
+    }
 }
 
 /// Progress over the planes of both passes, shared by extract()'s tasks: every task ticks once per
@@ -294,7 +311,8 @@ template <class Task> void run_tasks(int n, const Executor& executor, Task&& tas
 template <class T> class RangeExtractor {
 public:
     RangeExtractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
-        : g_(g), iso_(iso), above_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
+        : g_(g), iso_(iso), threshold_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
+          words_((nx_ + 63) / 64), sample_valid_(valid_words(words_, nx_)), x_valid_(valid_words(words_, nx_ - 1)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
           delta_(min_crossing(g, m_))
     {
@@ -305,6 +323,14 @@ public:
             needs_values_[code] = opt.method != Method::mc &&
                                   (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
         }
+    }
+
+    /// Gives every range the bound on |sample| of them all (which have read every sample).
+    static void share_largest_sample(std::vector<RangeCounts>& counts)
+    {
+        double largest = 0;
+        for (const RangeCounts& c : counts) largest = std::max(largest, c.largest_sample_);
+        for (RangeCounts& c : counts) c.largest_sample_ = largest;
     }
 
     /// Whether `c` was counted on a grid with these rows.
@@ -330,11 +356,20 @@ public:
             // plane k1 is the next range's: its rows' x/y edge vertices come first there
             c.seam_first_.assign(static_cast<std::size_t>(ny_) + 1, 0);
             for (std::int64_t j = 0; j < ny_; ++j) {
-                const std::uint8_t* f = flags(j, k1, s);
-                const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k1, s) : f;
-                c.seam_first_[static_cast<std::size_t>(j) + 1] = c.seam_first_[static_cast<std::size_t>(j)] + xy_crossings(f, fy, nx_);
+                const Word* f = flags(j, k1, s);
+                const Word* fy = j + 1 < ny_ ? flags(j + 1, k1, s) : f;
+                std::uint32_t xy = 0;
+                for (std::int64_t w = 0; w < words_; ++w) {
+                    const EdgeWords e(f, fy, f, w, x_valid_[static_cast<std::size_t>(w)]);
+                    xy += static_cast<std::uint32_t>(std::popcount(e.x) + std::popcount(e.y));
+                }
+                c.seam_first_[static_cast<std::size_t>(j) + 1] = c.seam_first_[static_cast<std::size_t>(j)] + xy;
             }
         }
+        // every sample of planes k0..k1 has been classified, which also looked for non-finite ones
+        if (s.scan.non_finite) scan_samples(g_, k0, std::min(k1, nz_ - 1)); // throws, naming the first
+        // (for integer types, the type's bound: scan_samples reads nothing then)
+        c.largest_sample_ = std::max(largest_sample, std::is_floating_point_v<T> ? s.scan.largest : scan_samples(g_, k0, k0));
         // the rows hold their counts; turn them into first ids (the numbering of passes.hpp)
         std::int64_t v = 0, t = 0;
         const auto first_id = [&v, k0, k1](std::uint32_t& count) {
@@ -376,7 +411,7 @@ public:
                 if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
                 std::int64_t interior = 0;
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
-                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices(j, k, ids, e); // else row_ids left them stale
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices(j, k, ids, s, e);
                 std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
                 if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end);
                 if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
@@ -407,13 +442,13 @@ private:
         double gradient_scale;
     };
 
-    /// One thread's working memory: above-flags of three slices, vertex ids of four sample rows,
-    /// and the column codes of the current cell row. O(nx * ny) bytes.
+    /// One thread's working memory: above-flags of three slices (3 nx ny / 8 bytes), vertex ids
+    /// of four sample rows, and what classifying the rows saw.
     struct Scratch {
-        Scratch(std::int64_t nx, std::int64_t ny) : flags(nx, ny), ids(nx), columns(static_cast<std::size_t>(nx)) {}
-        SliceFlags flags;
+        Scratch(std::int64_t nx, std::int64_t ny) : masks(nx, ny), ids(nx) {}
+        SliceMasks masks;
         IdRows ids;
-        std::vector<std::uint8_t> columns;
+        detail::RowScan scan;
     };
 
     /// The range-relative ids of row (j, k) of a range: x/y edge vertices [xy0, xy1), z edge and
@@ -442,40 +477,28 @@ private:
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
 
-    /// Above-flags of the samples of row (j, k), and the row's kind (SliceFlags).
-    CMC33_ALWAYS_INLINE const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
+    /// Above-flags of the samples of row (j, k), and the row's kind (SliceMasks).
+    CMC33_ALWAYS_INLINE const Word* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
     {
         bool fresh = false;
         std::uint8_t* known = nullptr;
-        std::uint8_t* f = s.flags.get(j, k, fresh, known);
+        Word* f = s.masks.get(j, k, fresh, known);
         if (fresh) {
-            above_.row(g_.data + g_.offset(0, j, k), nx_, sx_, f);
-            std::uint8_t any = 0, all = 1; // byte reductions: they vectorise to one op per 16 samples
-            const std::int64_t n = nx_;
-            for (std::int64_t i = 0; i < n; ++i) any |= f[i], all &= f[i];
-            *known = all ? SliceFlags::kAbove : any ? SliceFlags::kMixed : SliceFlags::kBelow;
+            detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
+            Word any = 0, all = ~Word{0};
+            for (std::int64_t w = 0; w < words_; ++w) {
+                any |= f[w];
+                all &= f[w] | ~sample_valid_[static_cast<std::size_t>(w)];
+            }
+            *known = all == ~Word{0} ? SliceMasks::kAbove : any ? SliceMasks::kMixed : SliceMasks::kBelow;
         }
         kind = *known;
         return f;
     }
-    const std::uint8_t* flags(std::int64_t j, std::int64_t k, Scratch& s) const
+    const Word* flags(std::int64_t j, std::int64_t k, Scratch& s) const
     {
         std::uint8_t unused = 0;
         return flags(j, k, s, unused);
-    }
-
-    /// Column codes of cell row (j, k) into s.columns (see kCellCode).
-    void column_codes(std::int64_t j, std::int64_t k, Scratch& s) const
-    {
-        const std::uint8_t* __restrict f00 = flags(j, k, s);
-        const std::uint8_t* __restrict f10 = flags(j + 1, k, s);
-        const std::uint8_t* __restrict f01 = flags(j, k + 1, s);
-        const std::uint8_t* __restrict f11 = flags(j + 1, k + 1, s);
-        std::uint8_t* __restrict col = s.columns.data();
-        const std::int64_t n = nx_; // a local bound: byte stores may alias members, which blocks vectorising
-        for (std::int64_t i = 0; i < n; ++i) {
-            col[i] = static_cast<std::uint8_t>(f00[i] | f10[i] << 1 | f01[i] << 2 | f11[i] << 3);
-        }
     }
 
     /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
@@ -496,13 +519,17 @@ private:
             *end = interior = -1; // not this range's row: no vertex of it is written
             const std::int64_t seam0 = e.c.seam_first_[static_cast<std::size_t>(j)];
             if (seam0 == e.c.seam_first_[static_cast<std::size_t>(j) + 1]) return ids; // nothing crosses: never read
-            const std::uint8_t* f = flags(j, k, s);
-            const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+            const Word* f = flags(j, k, s);
+            const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
             auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.vertices_ + seam0);
-            for (std::int64_t i = 0; i < nx_; ++i) {
-                const unsigned crossed = crossed_edges(f, fy, f, i, nx_);
-                ids[3 * i] = crossed & 1u ? xy++ : kNoVertex;
-                ids[3 * i + 1] = crossed & 2u ? xy++ : kNoVertex;
+            for (std::int64_t w = 0; w < words_; ++w) {
+                const EdgeWords edges(f, fy, f, w, x_valid_[static_cast<std::size_t>(w)]);
+                for (Word bits = edges.x | edges.y; bits != 0; bits &= bits - 1) {
+                    const int b = std::countr_zero(bits);
+                    const std::int64_t i = 64 * w + b;
+                    if ((edges.x >> b) & 1u) ids[3 * i] = xy++;
+                    if ((edges.y >> b) & 1u) ids[3 * i + 1] = xy++;
+                }
             }
             if (xy != e.off.first_vertex + e.c.vertices_ + e.c.seam_first_[static_cast<std::size_t>(j) + 1]) {
                 throw_mismatch("x/y edge vertices of the next range's first plane", j, k);
@@ -515,22 +542,28 @@ private:
             *end = interior = e.off.first_vertex + r.z0;
             return ids;
         }
-        const std::uint8_t* f = flags(j, k, s);
-        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
-        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+        const Word* f = flags(j, k, s);
+        const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+        const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
         auto xy = static_cast<std::uint32_t>(e.off.first_vertex + r.xy0);
         auto z = static_cast<std::uint32_t>(e.off.first_vertex + r.z0);
-        // outside the trim range no edge crosses: those slots are never read for a vertex
-        for (std::int64_t i = r.lo; i < r.hi; ++i) {
-            // branch-free (selects, not jumps): crossings are unpredictable on rough surfaces
-            const unsigned crossed = crossed_edges(f, fy, fz, i, nx_);
-            const unsigned cx = crossed & 1u, cy = (crossed >> 1) & 1u, cz = crossed >> 2;
-            ids[3 * i] = cx ? xy : kNoVertex;
-            xy += cx;
-            ids[3 * i + 1] = cy ? xy : kNoVertex;
-            xy += cy;
-            ids[3 * i + 2] = cz ? z : kNoVertex;
-            z += cz;
+        // outside the trim range [lo, hi) no edge crosses
+        for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+            const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
+            for (Word bits = edges.any(); bits != 0; bits &= bits - 1) {
+                const int b = std::countr_zero(bits);
+                std::uint32_t* slot = &ids[3 * (64 * w + b)];
+                // branch-free (selects, not jumps): crossings are unpredictable on rough surfaces
+                const auto cx = static_cast<std::uint32_t>((edges.x >> b) & 1u);
+                const auto cy = static_cast<std::uint32_t>((edges.y >> b) & 1u);
+                const auto cz = static_cast<std::uint32_t>((edges.z >> b) & 1u);
+                slot[0] = xy;
+                xy += cx;
+                slot[1] = xy;
+                xy += cy;
+                slot[2] = z;
+                z += cz;
+            }
         }
         if (xy != e.off.first_vertex + r.xy1) throw_mismatch("x/y edge vertices", j, k);
         if (z > e.off.first_vertex + r.v1) throw_mismatch("z edge vertices", j, k);
@@ -565,37 +598,36 @@ private:
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
         std::uint8_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
-        const std::uint8_t* f = flags(j, k, s, n0);
+        const Word* f = flags(j, k, s, n0);
         n1 = n2 = n3 = n0;
-        const std::uint8_t* fy = j + 1 < ny_ ? flags(j + 1, k, s, n1) : f;
-        const std::uint8_t* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
-        if (j + 1 < ny_ && k + 1 < nz_) flags(j + 1, k + 1, s, n3);
-        if (n0 != SliceFlags::kMixed && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
+        const bool cells = j + 1 < ny_ && k + 1 < nz_;
+        const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s, n1) : f;
+        const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
+        const Word* fyz = cells ? flags(j + 1, k + 1, s, n3) : f;
+        if (n0 != SliceMasks::kMixed && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
         RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
-        const std::uint32_t xy = xy_crossings(f, fy, nx_);
-        std::uint32_t z = 0;
-        for (std::int64_t i = 0; i < nx_; ++i) z += static_cast<std::uint32_t>(f[i] ^ fz[i]);
+        std::uint32_t xy = 0, z = 0;
         std::int64_t interior = 0, triangles = 0;
         std::int64_t lo = nx_, hi = 0;
-        if (xy + z != 0) {
-            lo = 0;
-            while (crossed_edges(f, fy, fz, lo, nx_) == 0) ++lo;
-            hi = nx_;
-            while (crossed_edges(f, fy, fz, hi - 1, nx_) == 0) --hi;
-        }
-        if (j + 1 < ny_ && k + 1 < nz_) {
-            column_codes(j, k, s);
-            const std::uint8_t* col = s.columns.data();
-            for (std::int64_t i = 0; i + 1 < nx_; ++i) {
-                const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
-                if (code == 0 || code == 255) continue;
+        for (std::int64_t w = 0; w < words_; ++w) {
+            const Word x_valid = x_valid_[static_cast<std::size_t>(w)];
+            const EdgeWords edges(f, fy, fz, w, x_valid);
+            xy += static_cast<std::uint32_t>(std::popcount(edges.x) + std::popcount(edges.y));
+            z += static_cast<std::uint32_t>(std::popcount(edges.z));
+            const Word crossed = cells ? crossed_cells(f, fy, fz, fyz, w, x_valid) : 0;
+            const Word used = edges.any() | crossed; // samples whose edges or cells cross
+            if (used != 0) {
+                lo = std::min<std::int64_t>(lo, 64 * w + std::countr_zero(used));
+                hi = 64 * w + 64 - std::countl_zero(used);
+            }
+            for (Word bits = crossed; bits != 0; bits &= bits - 1) {
+                const int b = std::countr_zero(bits);
+                const unsigned code = cell_code(f, fy, fz, fyz, w, b);
                 int subcase = 0;
-                const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
+                const detail::Tiling& tl = tiling_of(64 * w + b, j, k, code, subcase);
                 interior += tl.interior_count;
                 triangles += tl.triangle_count;
                 ++c.stats_.cells_per_subcase[static_cast<std::size_t>(subcase)];
-                lo = std::min(lo, i);
-                hi = std::max(hi, i + 1);
             }
         }
         if (hi > lo) row.lo = static_cast<std::int32_t>(lo), row.hi = static_cast<std::int32_t>(hi);
@@ -684,47 +716,60 @@ private:
     std::array<double, 3> gradient(std::int64_t i, std::int64_t j, std::int64_t k, double scale) const
     {
         std::array<double, 3> grad{};
+        const T* p = g_.data + g_.offset(i, j, k);
         const std::int64_t idx[3] = {i, j, k};
         const std::int64_t n[3] = {nx_, ny_, nz_};
-        for (int axis = 0; axis < 3; ++axis) {
-            std::int64_t lo[3] = {i, j, k}, hi[3] = {i, j, k};
-            if (idx[axis] > 0) --lo[axis];
-            if (idx[axis] + 1 < n[axis]) ++hi[axis];
-            const double d = static_cast<double>(hi[axis] - lo[axis]) * step_[static_cast<std::size_t>(axis)];
-            grad[static_cast<std::size_t>(axis)] = (scale * static_cast<double>(at(hi[0], hi[1], hi[2])) -
-                                                    scale * static_cast<double>(at(lo[0], lo[1], lo[2]))) / d;
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+            const std::int64_t stride = g_.strides[axis];
+            const std::int64_t lo = idx[axis] > 0 ? -stride : 0, hi = idx[axis] + 1 < n[axis] ? stride : 0;
+            const double d = (lo != 0 && hi != 0 ? 2.0 : 1.0) * step_[axis];
+            grad[axis] = (scale * static_cast<double>(p[hi]) - scale * static_cast<double>(p[lo])) / d;
         }
         return grad;
     }
 
-    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, const Emit& e) const
+    /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them.
+    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Scratch& s, const Emit& e) const
     {
         const RowSpan r = span_of(e.c, j, k);
+        const Word* f = flags(j, k, s);
+        const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
+        const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+        for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+            const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
+            for (Word bits = edges.any(); bits != 0; bits &= bits - 1) {
+                const int b = std::countr_zero(bits);
+                const std::int64_t i = 64 * w + b;
+                if ((edges.x >> b) & 1u) emit_edge_vertex(i, j, k, 0, ids[3 * i], e);
+                if ((edges.y >> b) & 1u) emit_edge_vertex(i, j, k, 1, ids[3 * i + 1], e);
+                if ((edges.z >> b) & 1u) emit_edge_vertex(i, j, k, 2, ids[3 * i + 2], e);
+            }
+        }
+    }
+
+    /// The vertex `id` on the edge from sample (i, j, k) along `axis`.
+    CMC33_ALWAYS_INLINE void emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int axis, std::uint32_t id,
+                                              const Emit& e) const
+    {
         const MeshSpans& out = e.out;
-        for (std::int64_t slot = 3 * r.lo; slot < 3 * r.hi; ++slot) {
-            const std::uint32_t id = ids[slot];
-            if (id == kNoVertex) continue;
-            const std::int64_t i = slot / 3;
-            const int axis = static_cast<int>(slot % 3);
-            const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
-            const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
-            const double t = crossing(a, b);
-            const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
-            double x[3];
-            for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
-            const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
-            write_position(x, &out.positions[v * 3]);
-            if (out.normals) {
-                const auto ga = gradient(i, j, k, e.gradient_scale), gb = gradient(end[0], end[1], end[2], e.gradient_scale);
-                write_normal(&out.normals[v * 3],
-                             {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
-            }
-            if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
-            if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
-            if (out.vertex_values) {
-                const double va = static_cast<double>(a), vb = static_cast<double>(b);
-                out.vertex_values[v] = static_cast<float>(va + t * (vb - va));
-            }
+        const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
+        const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
+        const double t = crossing(a, b);
+        const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+        double x[3];
+        for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
+        const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
+        write_position(x, &out.positions[v * 3]);
+        if (out.normals) {
+            const auto ga = gradient(i, j, k, e.gradient_scale), gb = gradient(end[0], end[1], end[2], e.gradient_scale);
+            write_normal(&out.normals[v * 3],
+                         {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
+        }
+        if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
+        if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
+        if (out.vertex_values) {
+            const double va = static_cast<double>(a), vb = static_cast<double>(b);
+            out.vertex_values[v] = static_cast<float>(va + t * (vb - va));
         }
     }
 
@@ -757,24 +802,23 @@ private:
         std::int64_t unused = 0;
         const std::uint32_t* ids[4] = {row_ids(j, k, s, e, unused), row_ids(j + 1, k, s, e, unused),
                                        row_ids(j, k + 1, s, e, unused), row_ids(j + 1, k + 1, s, e, unused)};
-        column_codes(j, k, s);
-        const std::uint8_t* col = s.columns.data();
+        const Word* f00 = flags(j, k, s);
+        const Word* f10 = flags(j + 1, k, s);
+        const Word* f01 = flags(j, k + 1, s);
+        const Word* f11 = flags(j + 1, k + 1, s);
         const RowSpan r = span_of(e.c, j, k);
         const MeshSpans& out = e.out;
         tri = e.off.first_triangle + r.t0;
-        const std::int64_t last = std::min<std::int64_t>(r.hi, nx_ - 1);
-        bool missing = false; // a triangle on an edge that does not cross
-        for (std::int64_t i = r.lo; i < last; ++i) {
-            const unsigned code = kCellCode[static_cast<unsigned>(col[i] | col[i + 1] << 4)];
-            if (code == 0 || code == 255) continue;
+        // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
+        // are crossed edges, whose slots row_ids wrote.
+        for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+          for (Word bits = crossed_cells(f00, f10, f01, f11, w, x_valid_[static_cast<std::size_t>(w)]); bits != 0;
+               bits &= bits - 1) {
+            const int bit = std::countr_zero(bits);
+            const std::int64_t i = 64 * w + bit;
+            const unsigned code = cell_code(f00, f10, f01, f11, w, bit);
             int subcase = 0;
             const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
-            std::uint32_t edge_id[12];
-            for (int q = 0; q < 12; ++q) {
-                const int c = kEdgeCorners[q][0];
-                const std::uint32_t* row = ids[kCornerOffset[c][1] + 2 * kCornerOffset[c][2]];
-                edge_id[q] = row[3 * (i + kCornerOffset[c][0]) + q / 4];
-            }
             if (vertex + tl.interior_count > e.off.first_vertex + r.v1 ||
                 tri + tl.triangle_count > e.off.first_triangle + r.t1) {
                 throw_mismatch("cells", j, k); // before writing past the row's part of the output
@@ -787,8 +831,8 @@ private:
             std::uint32_t* o = &out.triangles[t0 * 3];
             for (int q = 0; q < 3 * tl.triangle_count; ++q) {
                 const int v = codes[q];
-                o[q] = v < 12 ? edge_id[v] : static_cast<std::uint32_t>(first_interior + (v - 12));
-                missing |= o[q] == kNoVertex;
+                o[q] = v < 12 ? ids[kEdgeRow[static_cast<std::size_t>(v)]][3 * i + kEdgeSlot[static_cast<std::size_t>(v)]]
+                              : static_cast<std::uint32_t>(first_interior + (v - 12));
             }
             if (mirrored_) {
                 for (int q = 0; q < 3 * tl.triangle_count; q += 3) std::swap(o[q + 1], o[q + 2]);
@@ -798,8 +842,8 @@ private:
                 for (int q = 0; q < tl.triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
             tri += tl.triangle_count;
+          }
         }
-        if (missing) throw_mismatch("crossed edges", j, k);
     }
 
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
@@ -856,9 +900,12 @@ private:
 
     const GridView<T>& g_;
     double iso_;
-    Above<T> above_;
+    detail::Threshold<T> threshold_;
     Method method_;
     std::int64_t nx_, ny_, nz_, sx_;
+    std::int64_t words_;               ///< words of a row's flags
+    std::vector<Word> sample_valid_;   ///< bits of the samples 0..nx-1
+    std::vector<Word> x_valid_;        ///< bits of the x edges and cells 0..nx-2
     Mat3 m_;                  ///< index to world: M = D * diag(spacing)
     bool diagonal_, mirrored_; ///< M diagonal; det M < 0 (triangles are reversed)
     double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
@@ -911,33 +958,6 @@ template <class T> void check_grid(const GridView<T>& g, double iso)
     }
 }
 
-/// The largest |sample| of planes [k_lo, k_hi] (for integer types, the type's bound).
-/// @throws Error{non_finite} for NaN or infinite samples there, saying how many and the first
-template <class T> double largest_sample(const GridView<T>& g, std::int64_t k_lo, std::int64_t k_hi)
-{
-    if constexpr (std::is_floating_point_v<T>) {
-        double largest = 0;
-        std::int64_t count = 0;
-        Index3 first{-1, -1, -1};
-        for (std::int64_t k = k_lo; k <= k_hi; ++k)
-            for (std::int64_t j = 0; j < g.ny(); ++j)
-                for (std::int64_t i = 0; i < g.nx(); ++i) {
-                    const double v = std::fabs(static_cast<double>(g(i, j, k)));
-                    if (!std::isfinite(v) && count++ == 0) first = {i, j, k};
-                    largest = std::max(largest, v);
-                }
-        if (count > 0) {
-            throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
-                                                std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
-                                                std::to_string(first[2]) + "); cmc33 needs finite samples");
-        }
-        return largest;
-    } else {
-        return std::max(std::fabs(static_cast<double>(std::numeric_limits<T>::lowest())),
-                        static_cast<double>(std::numeric_limits<T>::max()));
-    }
-}
-
 std::string range_text(std::int64_t k0, std::int64_t k1)
 {
     return "[" + std::to_string(k0) + ", " + std::to_string(k1) + ")";
@@ -953,7 +973,10 @@ RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& opt
         throw Error(Status::invalid_argument, "count: sample planes " + range_text(k0, k1) + "; expected 0 <= k0 < k1 <= " +
                                                   std::to_string(grid.nz()) + " (the grid's nz)");
     }
-    const double largest = largest_sample(grid, std::max<std::int64_t>(k0 - 1, 0), std::min(k1 + 1, grid.nz() - 1));
+    // count reads planes k0..k1 (checking them as it goes); emit's normals also read k0 - 1 and k1 + 1
+    double largest = 0;
+    if (k0 > 0) largest = scan_samples(grid, k0 - 1, k0 - 1);
+    if (k1 + 1 < grid.nz()) largest = std::max(largest, scan_samples(grid, k1 + 1, k1 + 1));
     return RangeExtractor<T>(grid, iso, options).count(k0, k1, largest, nullptr);
 }
 
@@ -993,16 +1016,16 @@ template <class T> Mesh extract(const GridView<T>& grid, double iso, const Extra
 {
     check_grid(grid, iso);
     const std::int64_t nz = grid.nz();
-    const double largest = largest_sample(grid, 0, nz - 1);
     const RangeExtractor<T> extractor(grid, iso, options);
     const int n = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, nz));
     Ticker ticker(options.progress, 2 * nz);
 
     std::vector<RangeCounts> counts(static_cast<std::size_t>(n));
     run_tasks(n, options.executor, [&](int t) {
-        counts[static_cast<std::size_t>(t)] = extractor.count(nz * t / n, nz * (t + 1) / n, largest, &ticker);
+        counts[static_cast<std::size_t>(t)] = extractor.count(nz * t / n, nz * (t + 1) / n, 0.0, &ticker);
     });
     if (ticker.cancelled()) throw_cancelled();
+    RangeExtractor<T>::share_largest_sample(counts);
     const std::vector<RangeOffsets> offsets = scan(counts);
     const std::int64_t nv = offsets.back().first_vertex + counts.back().vertex_count();
     const std::int64_t nt = offsets.back().first_triangle + counts.back().triangle_count();

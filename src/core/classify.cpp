@@ -1,0 +1,268 @@
+// classify_row (classify.hpp): the above-flags of a sample row as bitmasks, AVX2 or portable.
+
+#include "classify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define CMC33_CLASSIFY_AVX2 1
+#include <immintrin.h>
+#else
+#define CMC33_CLASSIFY_AVX2 0
+#endif
+
+namespace cmc33::detail {
+
+template <class T> Threshold<T>::Threshold(double iso)
+{
+    if constexpr (std::is_integral_v<T>) {
+        const double t = std::ceil(iso);
+        if (t <= static_cast<double>(std::numeric_limits<T>::lowest())) {
+            mode = Mode::all;
+        } else if (t > static_cast<double>(std::numeric_limits<T>::max())) {
+            mode = Mode::none;
+        } else {
+            value = static_cast<T>(t);
+        }
+    } else if constexpr (std::is_same_v<T, float>) {
+        // the smallest float f with double(f) >= iso: every float v has v >= f iff double(v) >= iso
+        float f = static_cast<float>(iso); // nearest (or +-inf beyond the float range)
+        if (static_cast<double>(f) < iso) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+        value = f;
+    } else {
+        value = static_cast<T>(iso);
+    }
+}
+
+namespace {
+
+/// One sample at a time: the reference the vector code must equal, and the strided path.
+template <class T>
+void classify_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& th, std::uint64_t* bits,
+                       RowScan& scan)
+{
+    const std::int64_t words = (n + 63) / 64;
+    const T t = th.value;
+    for (std::int64_t w = 0; w < words; ++w) {
+        const std::int64_t i0 = 64 * w, i1 = std::min<std::int64_t>(n, i0 + 64);
+        std::uint64_t m = 0;
+        if constexpr (std::is_floating_point_v<T>) {
+            double largest = scan.largest;
+            bool bad = false;
+            for (std::int64_t i = i0; i < i1; ++i) {
+                const T v = row[i * stride];
+                m |= static_cast<std::uint64_t>(v >= t) << (i - i0);
+                const double a = std::fabs(static_cast<double>(v));
+                bad |= !(a <= std::numeric_limits<double>::max());
+                if (a > largest && !std::isinf(a)) largest = a;
+            }
+            scan.largest = largest;
+            scan.non_finite |= bad;
+        } else {
+            for (std::int64_t i = i0; i < i1; ++i) m |= static_cast<std::uint64_t>(row[i * stride] >= t) << (i - i0);
+        }
+        bits[w] = m;
+    }
+}
+
+#if CMC33_CLASSIFY_AVX2
+
+/// Bit b of the result: sample b of the 32 (8-bit), 16 (16-bit) or 8 (32-bit) at p is below t.
+/// Unsigned samples are compared as signed after flipping their top bit on both sides.
+#define CMC33_AVX2 __attribute__((target("avx2")))
+
+template <class T> CMC33_AVX2 inline __m256i bias()
+{
+    if constexpr (std::is_unsigned_v<T>) {
+        if constexpr (sizeof(T) == 1) return _mm256_set1_epi8(static_cast<char>(0x80));
+        if constexpr (sizeof(T) == 2) return _mm256_set1_epi16(static_cast<short>(0x8000));
+        if constexpr (sizeof(T) == 4) return _mm256_set1_epi32(static_cast<int>(0x80000000u));
+    }
+    return _mm256_setzero_si256();
+}
+
+template <class T> CMC33_AVX2 inline __m256i broadcast(T t)
+{
+    if constexpr (sizeof(T) == 1) return _mm256_set1_epi8(static_cast<char>(t));
+    if constexpr (sizeof(T) == 2) return _mm256_set1_epi16(static_cast<short>(t));
+    return _mm256_set1_epi32(static_cast<int>(t));
+}
+
+template <class T> CMC33_AVX2 inline __m256i load_biased(const T* p, int q, __m256i b)
+{
+    return _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p) + q), b);
+}
+
+/// 64 integer samples at p against t (biased): the above-bits.
+template <class T> CMC33_AVX2 inline std::uint64_t above64_int(const T* p, __m256i t, __m256i b)
+{
+    std::uint64_t below = 0;
+    if constexpr (sizeof(T) == 1) {
+        for (int q = 0; q < 2; ++q) {
+            const auto m = static_cast<std::uint32_t>(_mm256_movemask_epi8(_mm256_cmpgt_epi8(t, load_biased(p, q, b))));
+            below |= std::uint64_t{m} << (32 * q);
+        }
+    } else if constexpr (sizeof(T) == 2) {
+        for (int q = 0; q < 2; ++q) {
+            const __m256i lo = _mm256_cmpgt_epi16(t, load_biased(p, 2 * q, b));
+            const __m256i hi = _mm256_cmpgt_epi16(t, load_biased(p, 2 * q + 1, b));
+            // packs interleaves 128-bit lanes (lo0 hi0 lo1 hi1); the permute restores the order
+            const __m256i packed = _mm256_permute4x64_epi64(_mm256_packs_epi16(lo, hi), 0xD8);
+            const auto m = static_cast<std::uint32_t>(_mm256_movemask_epi8(packed));
+            below |= std::uint64_t{m} << (32 * q);
+        }
+    } else {
+        for (int q = 0; q < 8; ++q) {
+            const __m256 c = _mm256_castsi256_ps(_mm256_cmpgt_epi32(t, load_biased(p, q, b)));
+            below |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_ps(c))) << (8 * q);
+        }
+    }
+    return ~below;
+}
+
+template <class T>
+CMC33_AVX2 void classify_avx2_int(const T* row, std::int64_t n, const Threshold<T>& th, std::uint64_t* bits)
+{
+    const __m256i b = bias<T>();
+    const __m256i t = _mm256_xor_si256(broadcast<T>(th.value), b);
+    const std::int64_t full = n / 64;
+    for (std::int64_t w = 0; w < full; ++w) bits[w] = above64_int<T>(row + 64 * w, t, b);
+    if (n % 64 != 0) {
+        RowScan unused;
+        classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, unused);
+    }
+}
+
+CMC33_AVX2 void classify_avx2_float(const float* row, std::int64_t n, const Threshold<float>& th, std::uint64_t* bits,
+                                    RowScan& scan)
+{
+    const __m256 t = _mm256_set1_ps(th.value);
+    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
+    __m256 largest = _mm256_setzero_ps(); // of the finite samples: max_ps keeps its first operand on NaN
+    __m256 bad = _mm256_setzero_ps();
+    const std::int64_t full = n / 64;
+    for (std::int64_t w = 0; w < full; ++w) {
+        std::uint64_t m = 0;
+        for (int q = 0; q < 8; ++q) {
+            const __m256 v = _mm256_loadu_ps(row + 64 * w + 8 * q);
+            m |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v, t, _CMP_GE_OQ))))
+                 << (8 * q);
+            const __m256 a = _mm256_and_ps(v, abs_mask);
+            bad = _mm256_or_ps(bad, _mm256_cmp_ps(a, inf, _CMP_NLT_UQ)); // inf or NaN
+            largest = _mm256_blendv_ps(_mm256_max_ps(largest, a), largest, _mm256_cmp_ps(a, inf, _CMP_NLT_UQ));
+        }
+        bits[w] = m;
+    }
+    alignas(32) float lanes[8];
+    _mm256_store_ps(lanes, largest);
+    for (float x : lanes) scan.largest = std::max(scan.largest, static_cast<double>(x));
+    scan.non_finite |= _mm256_movemask_ps(bad) != 0;
+    if (n % 64 != 0) classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan);
+}
+
+CMC33_AVX2 void classify_avx2_double(const double* row, std::int64_t n, const Threshold<double>& th, std::uint64_t* bits,
+                                     RowScan& scan)
+{
+    const __m256d t = _mm256_set1_pd(th.value);
+    const __m256d abs_mask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff));
+    const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
+    __m256d largest = _mm256_setzero_pd();
+    __m256d bad = _mm256_setzero_pd();
+    const std::int64_t full = n / 64;
+    for (std::int64_t w = 0; w < full; ++w) {
+        std::uint64_t m = 0;
+        for (int q = 0; q < 16; ++q) {
+            const __m256d v = _mm256_loadu_pd(row + 64 * w + 4 * q);
+            m |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(v, t, _CMP_GE_OQ))))
+                 << (4 * q);
+            const __m256d a = _mm256_and_pd(v, abs_mask);
+            const __m256d not_finite = _mm256_cmp_pd(a, inf, _CMP_NLT_UQ);
+            bad = _mm256_or_pd(bad, not_finite);
+            largest = _mm256_blendv_pd(_mm256_max_pd(largest, a), largest, not_finite);
+        }
+        bits[w] = m;
+    }
+    alignas(32) double lanes[4];
+    _mm256_store_pd(lanes, largest);
+    for (double x : lanes) scan.largest = std::max(scan.largest, x);
+    scan.non_finite |= _mm256_movemask_pd(bad) != 0;
+    if (n % 64 != 0) classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan);
+}
+
+#undef CMC33_AVX2
+
+bool has_avx2()
+{
+    static const bool yes = __builtin_cpu_supports("avx2") != 0;
+    return yes;
+}
+
+#else
+
+constexpr bool has_avx2() { return false; }
+
+#endif
+
+} // namespace
+
+template <class T>
+void classify_row(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& th, std::uint64_t* bits,
+                  RowScan& scan)
+{
+    using Mode = typename Threshold<T>::Mode;
+    if (th.mode != Mode::compare) {
+        // every integer sample is above (or none is): no sample needs reading
+        const std::int64_t words = (n + 63) / 64;
+        const std::uint64_t fill = th.mode == Mode::all ? ~std::uint64_t{0} : 0;
+        for (std::int64_t w = 0; w < words; ++w) bits[w] = fill;
+        if (n % 64 != 0) bits[words - 1] &= (std::uint64_t{1} << (n % 64)) - 1;
+        return;
+    }
+#if CMC33_CLASSIFY_AVX2
+    if (stride == 1 && has_avx2()) {
+        if constexpr (std::is_same_v<T, float>) {
+            classify_avx2_float(row, n, th, bits, scan);
+        } else if constexpr (std::is_same_v<T, double>) {
+            classify_avx2_double(row, n, th, bits, scan);
+        } else {
+            classify_avx2_int(row, n, th, bits);
+        }
+        return;
+    }
+#endif
+    classify_portable(row, n, stride, th, bits, scan);
+}
+
+template <class T>
+void classify_row_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& th, std::uint64_t* bits,
+                           RowScan& scan)
+{
+    if (th.mode != Threshold<T>::Mode::compare) {
+        classify_row(row, n, stride, th, bits, scan);
+        return;
+    }
+    classify_portable(row, n, stride, th, bits, scan);
+}
+
+const char* classify_implementation() { return has_avx2() ? "avx2" : "portable"; }
+
+#define CMC33_INSTANTIATE(T)                                                                                     \
+    template struct Threshold<T>;                                                                                \
+    template void classify_row<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*, RowScan&); \
+    template void classify_row_portable<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*,   \
+                                           RowScan&);
+CMC33_INSTANTIATE(std::int8_t)
+CMC33_INSTANTIATE(std::uint8_t)
+CMC33_INSTANTIATE(std::int16_t)
+CMC33_INSTANTIATE(std::uint16_t)
+CMC33_INSTANTIATE(std::int32_t)
+CMC33_INSTANTIATE(std::uint32_t)
+CMC33_INSTANTIATE(float)
+CMC33_INSTANTIATE(double)
+#undef CMC33_INSTANTIATE
+
+} // namespace cmc33::detail
