@@ -9,7 +9,10 @@
 // Every decision is the sign of a polynomial (degree <= 6) in the eight values. It is computed
 // exactly: first in double arithmetic with a running error bound (Filtered); when a sign is within
 // its bound (a tie, or a near-tie such as decimal data whose exact sum is 0 but rounds to 1e-17),
-// the cell is decided again in exact rational arithmetic (GMP's mpq_class) on the same doubles.
+// the cell is decided again exactly on the same doubles: in 128-bit integers when the values are
+// small multiples of a power of two (integer-valued floats, halves, quarters: the common ties,
+// decided without allocating), else in rational arithmetic (GMP's mpq_class). Nothing throws: an
+// unsettled sign raises a per-thread flag that decide() reads once per cell.
 // So the extractor and the verifier, which decides exactly too, see the same field.
 
 #include <gmpxx.h>
@@ -26,8 +29,9 @@ namespace cmc33::detail {
 
 inline constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-/// Thrown by a Filtered sign that rounding cannot settle; decide() then starts over exactly.
-struct Uncertain {};
+/// Raised by a Filtered sign that rounding cannot settle (the sign then returned is 0, and the
+/// decision is discarded); decide() lowers it and starts over exactly.
+inline thread_local bool filter_uncertain = false;
 
 /// A double and a bound on its distance to the exact value of the same expression. Each operation
 /// adds its own rounding (relative 2^-50, a few times the unit roundoff, so that rounding in the
@@ -62,8 +66,8 @@ inline int sgn(const Filtered& f)
 {
     if (f.v > f.e) return 1;
     if (-f.v > f.e) return -1;
-    if (f.v == 0 && f.e == 0) return 0;
-    throw Uncertain{};
+    if (!(f.v == 0 && f.e == 0)) filter_uncertain = true;
+    return 0;
 }
 inline int sgn(const mpq_class& q) { return mpq_sgn(q.get_mpq_t()); }
 
@@ -282,7 +286,7 @@ struct Decision {
     unsigned joined; ///< the face tests: bit i for the i-th ambiguous face of the configuration
 };
 
-/// decide() in the number type R (Filtered: may throw Uncertain; mpq_class: exact). `raw` are the
+/// decide() in the number type R (Filtered: may raise filter_uncertain; the others: exact). `raw` are the
 /// corner samples, `v` the same minus iso rounded to double (their signs, and mc33-lewiner's
 /// t_alt); the decisions use raw - iso computed in R.
 template <class R> Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
@@ -310,28 +314,36 @@ template <class R> Decision decide_in(const double* raw, double iso, const doubl
 /// Decides one cell with `config` not 0 or 255: in filtered double arithmetic, and where rounding
 /// could change a sign, again exactly.
 /// `raw`: the eight corner samples (corner order of cube.hpp). `integers`: try the 128-bit integer
-/// path first (the extractor passes true for integer sample types).
+/// path first (the extractor passes true for integer sample types, where it nearly always applies;
+/// floating-point samples take it only after the filter could not settle a sign).
 inline Decision decide(const double* raw, double iso, unsigned config, Method method, bool integers)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
-    // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
 #if CMC33_HAS_INT128
-    if (integers && method == Method::cmc33) {
-        if (const double scale = small_integer_scale(raw, iso); scale != 0) {
-            double scaled[8];
-            for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
-            return decide_in<Int128>(scaled, iso * scale, v, config, method);
-        }
-    }
+    // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
+    const auto exact_integers = [&](Decision& d) {
+        if (method != Method::cmc33) return false;
+        const double scale = small_integer_scale(raw, iso);
+        if (scale == 0) return false;
+        double scaled[8];
+        for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
+        d = decide_in<Int128>(scaled, iso * scale, v, config, method);
+        return true;
+    };
+    Decision d{};
+    if (integers && exact_integers(d)) return d;
 #else
     (void)integers;
 #endif
-    try {
-        return decide_in<Filtered>(raw, iso, v, config, method);
-    } catch (const Uncertain&) {
-        return decide_in<mpq_class>(raw, iso, v, config, method);
-    }
+    filter_uncertain = false;
+    const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method);
+    if (!filter_uncertain) return filtered;
+    filter_uncertain = false;
+#if CMC33_HAS_INT128
+    if (!integers && exact_integers(d)) return d;
+#endif
+    return decide_in<mpq_class>(raw, iso, v, config, method);
 }
 
 } // namespace cmc33::detail

@@ -278,6 +278,30 @@ TEST(Extract, TypedAndStridedViewsGiveTheSameMesh)
     EXPECT_EQ(a.triangles, c.triangles);
 }
 
+// Ties in float data ({60, 80, 100} at 80, and the same halved at 40) are settled by the exact
+// integer path after the filter gives up: the same tilings as the uint8 grid, so the same
+// triangles, and the same positions up to the halving.
+TEST(Extract, FloatTiesAreDecidedLikeTheirIntegerGrid)
+{
+    std::mt19937_64 rng(17);
+    const std::uint8_t values[3] = {60, 80, 100};
+    for (int g = 0; g < 20; ++g) {
+        Volume u8(cmc33::ScalarType::u8, {9, 8, 7}), f32(cmc33::ScalarType::f32, {9, 8, 7});
+        Volume half(cmc33::ScalarType::f32, {9, 8, 7});
+        for (std::int64_t i = 0; i < u8.sample_count(); ++i) {
+            const std::uint8_t x = values[rng() % 3];
+            u8.samples<std::uint8_t>()[i] = x;
+            f32.samples<float>()[i] = x;
+            half.samples<float>()[i] = x / 2.0f;
+        }
+        const cmc33::Mesh a = cmc33::extract(u8, 80.0), b = cmc33::extract(f32, 80.0), c = cmc33::extract(half, 40.0);
+        ASSERT_EQ(a.triangles, b.triangles) << "grid " << g;
+        ASSERT_EQ(a.positions, b.positions) << "grid " << g;
+        ASSERT_EQ(a.triangles, c.triangles) << "grid " << g;
+        EXPECT_EQ(cmc33::mesh_topology(b).nonmanifold_edges, 0) << "grid " << g;
+    }
+}
+
 TEST(Extract, RejectsNonFiniteAndTooSmallGrids)
 {
     Volume v(cmc33::ScalarType::f32, {4, 4, 4});
