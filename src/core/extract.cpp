@@ -303,6 +303,27 @@ template <class Task> void run_tasks(int n, const Executor& executor, Task&& tas
     }
 }
 
+/// Runs work(0..ranges-1) on n tasks of run_tasks, each taking the next range not yet taken, until
+/// none is left or the ticker says stop; rethrows the error of the lowest range that failed, so
+/// that the error does not depend on which thread ran which range.
+template <class Work> void for_each_range(int n, int ranges, const Executor& executor, const Ticker& ticker, Work&& work)
+{
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ranges));
+    std::atomic<int> next{0};
+    run_tasks(n, executor, [&](int) {
+        for (int r = next.fetch_add(1); r < ranges && !ticker.cancelled(); r = next.fetch_add(1)) {
+            try {
+                work(r);
+            } catch (...) {
+                errors[static_cast<std::size_t>(r)] = std::current_exception();
+            }
+        }
+    });
+    for (auto& e : errors) {
+        if (e) std::rethrow_exception(e);
+    }
+}
+
 } // namespace
 
 /// The passes of passes.hpp for one grid and isovalue: what does not depend on the range (the
@@ -1018,12 +1039,22 @@ template <class T> Mesh extract(const GridView<T>& grid, double iso, const Extra
     const std::int64_t nz = grid.nz();
     const RangeExtractor<T> extractor(grid, iso, options);
     const int n = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, nz));
+    // More ranges than threads, taken in turn by whichever thread is free: a surface is seldom
+    // spread evenly over the planes. Ranges of at least 8 planes keep the planes read twice (at
+    // the ranges' ends) few; the mesh is the same for every split.
+    const int ranges = n == 1 ? 1 : static_cast<int>(std::clamp<std::int64_t>(nz / 8, n, 4 * std::int64_t{n}));
     Ticker ticker(options.progress, 2 * nz);
 
-    std::vector<RangeCounts> counts(static_cast<std::size_t>(n));
-    run_tasks(n, options.executor, [&](int t) {
-        counts[static_cast<std::size_t>(t)] = extractor.count(nz * t / n, nz * (t + 1) / n, 0.0, &ticker);
-    });
+    std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
+    try {
+        for_each_range(n, ranges, options.executor, ticker, [&](int r) {
+            counts[static_cast<std::size_t>(r)] = extractor.count(nz * r / ranges, nz * (r + 1) / ranges, 0.0, &ticker);
+        });
+    } catch (const Error& e) {
+        // a range names its own non-finite samples: say how many the whole grid has, and the first
+        if (e.status() == Status::non_finite) scan_samples(grid, 0, nz - 1);
+        throw;
+    }
     if (ticker.cancelled()) throw_cancelled();
     RangeExtractor<T>::share_largest_sample(counts);
     const std::vector<RangeOffsets> offsets = scan(counts);
@@ -1041,8 +1072,8 @@ template <class T> Mesh extract(const GridView<T>& grid, double iso, const Extra
     out.positions = mesh.positions.data();
     out.triangles = mesh.triangles.data();
     out.normals = options.normals ? mesh.normals.data() : nullptr;
-    run_tasks(n, options.executor, [&](int t) {
-        extractor.emit(counts[static_cast<std::size_t>(t)], offsets[static_cast<std::size_t>(t)], out, &ticker);
+    for_each_range(n, ranges, options.executor, ticker, [&](int r) {
+        extractor.emit(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], out, &ticker);
     });
     if (ticker.cancelled()) throw_cancelled();
     ticker.finish();
