@@ -7,8 +7,9 @@
 //   2. scan: consecutive ranges get consecutive first vertex and triangle ids;
 //   3. emit: each crossed grid edge is owned by its lower sample and gets one vertex; every cell
 //      writes its tiling's triangles and interior vertices at its row's offsets, finding edge
-//      vertices by edge ownership (no hash map, no locks). Tested cells are decided again rather
-//      than stored: working memory is O(rows + threads * nx * ny), not O(cells).
+//      vertices by edge ownership (no hash map, no locks). Cells with a face or interior test
+//      replay the decision count stored for them (one byte each, in the order count met them):
+//      working memory is O(rows + tested cells + threads * nx * ny), not O(cells).
 // extract() runs `threads` ranges as tasks; all writes land at offsets fixed by the scan, so the
 // mesh is the same, byte for byte, for every thread count and every split.
 //
@@ -337,7 +338,10 @@ public:
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
           delta_(min_crossing(g, m_))
     {
-        for (std::size_t a = 0; a < 3; ++a) step_[a] = diagonal_ ? m_[a][a] : 1.0;
+        for (std::size_t a = 0; a < 3; ++a) {
+            step_[a] = diagonal_ ? m_[a][a] : 1.0;
+            half_inverse_step_[a] = 0.5 / step_[a];
+        }
         if (!diagonal_) normal_map_ = inverse_transpose(m_);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
@@ -426,6 +430,7 @@ public:
         }
         const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
         Scratch s(nx_, ny_);
+        std::size_t decision = 0; // the next of count's decisions
         for (std::int64_t k = k0; k < k1; ++k) {
             for (std::int64_t j = 0; j < ny_; ++j) {
                 const RowSpan r = span_of(c, j, k);
@@ -434,12 +439,18 @@ public:
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
                 if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices(j, k, ids, s, e);
                 std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
-                if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end);
+                if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end, decision);
                 if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
                     throw_mismatch("vertices or triangles", j, k);
                 }
             }
             if (ticker && !ticker->tick()) return;
+        }
+        if (decision != c.decisions_.size()) {
+            throw Error(Status::internal, "emit met " + std::to_string(decision) + " cells with a face or interior test in planes " +
+                                              std::to_string(k0) + " to " + std::to_string(k1) + ", count " +
+                                              std::to_string(c.decisions_.size()) +
+                                              ": the samples, isovalue or method differ between the passes, or a bug in cmc33");
         }
     }
 
@@ -592,24 +603,30 @@ private:
         return ids;
     }
 
-    /// The tiling of crossed cell (i, j, k) with case code `code`, and its subcase. Cells with a
-    /// face or interior test are decided here, in count and again in emit (the same exact
-    /// predicates on the same values, so the same answer): that costs less than storing a
-    /// decision per cell, and leaves no per-cell working memory.
-    const detail::Tiling& tiling_of(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, int& subcase) const
+    /// Count's decision for crossed cell (i, j, k) with case code `code`, which needs_values_: its
+    /// tiling, its subcase, and as one byte for emit to replay, (face tests' bits << 2) | tiling
+    /// (at most 6 ambiguous faces and 3 tilings).
+    const detail::Tiling& decide_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, int& subcase,
+                                      std::uint8_t& decision) const
     {
-        const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
-        if (!needs_values_[code]) {
-            subcase = first.subcase;
-            return first.tilings[0];
-        }
         double raw[8];
         for (int c = 0; c < 8; ++c) {
             raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
         const detail::Decision d = detail::decide(raw, iso_, code, method_, std::is_integral_v<T>);
         subcase = d.subcase;
+        decision = static_cast<std::uint8_t>(d.joined << 2 | static_cast<unsigned>(d.tiling));
         return d.variant->tilings[d.tiling];
+    }
+
+    /// The tiling a decision byte of decide_cell() names for case code `code`; null when the byte
+    /// cannot be one of that code's (the samples changed between count and emit).
+    static const detail::Tiling* replay(unsigned code, std::uint8_t decision)
+    {
+        const unsigned joined = decision >> 2u, tiling = decision & 3u;
+        const unsigned variants = detail::kVariantOffset[code + 1] - detail::kVariantOffset[code];
+        if (joined >= variants || tiling > 2) return nullptr;
+        return &detail::kVariants[detail::kVariantOffset[code] + joined].tilings[tiling];
     }
 
     /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
@@ -644,10 +661,16 @@ private:
             for (Word bits = crossed; bits != 0; bits &= bits - 1) {
                 const int b = std::countr_zero(bits);
                 const unsigned code = cell_code(f, fy, fz, fyz, w, b);
-                int subcase = 0;
-                const detail::Tiling& tl = tiling_of(64 * w + b, j, k, code, subcase);
-                interior += tl.interior_count;
-                triangles += tl.triangle_count;
+                const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
+                int subcase = first.subcase;
+                const detail::Tiling* tl = &first.tilings[0];
+                if (needs_values_[code]) {
+                    std::uint8_t decision = 0;
+                    tl = &decide_cell(64 * w + b, j, k, code, subcase, decision);
+                    c.decisions_.push_back(decision);
+                }
+                interior += tl->interior_count;
+                triangles += tl->triangle_count;
                 ++c.stats_.cells_per_subcase[static_cast<std::size_t>(subcase)];
             }
         }
@@ -743,10 +766,48 @@ private:
         for (std::size_t axis = 0; axis < 3; ++axis) {
             const std::int64_t stride = g_.strides[axis];
             const std::int64_t lo = idx[axis] > 0 ? -stride : 0, hi = idx[axis] + 1 < n[axis] ? stride : 0;
-            const double d = (lo != 0 && hi != 0 ? 2.0 : 1.0) * step_[axis];
-            grad[axis] = (scale * static_cast<double>(p[hi]) - scale * static_cast<double>(p[lo])) / d;
+            // 1 / (2 step) inside, 1 / step at the border: a multiply, not a divide, per component
+            const double inverse = lo != 0 && hi != 0 ? half_inverse_step_[axis] : 2 * half_inverse_step_[axis];
+            grad[axis] = (scale * static_cast<double>(p[hi]) - scale * static_cast<double>(p[lo])) * inverse;
         }
         return grad;
+    }
+
+    /// The gradient at parameter t of the edge from sample (i, j, k) along `axis`: its ends'
+    /// gradients (gradient()) mixed linearly. Where both ends have all six neighbours (nearly
+    /// every vertex) the same numbers come from one bounds check and, for integer samples, exact
+    /// differences in their own arithmetic.
+    CMC33_ALWAYS_INLINE std::array<double, 3> edge_gradient(std::int64_t i, std::int64_t j, std::int64_t k, int axis,
+                                                            double t, double scale) const
+    {
+        const std::int64_t idx[3] = {i, j, k}, n[3] = {nx_, ny_, nz_};
+        bool inside = true;
+        for (int a = 0; a < 3; ++a) inside &= idx[a] >= 1 && idx[a] + 1 + (a == axis) < n[a];
+        std::array<double, 3> ga{}, gb{};
+        if (inside) {
+            const T* p = g_.data + g_.offset(i, j, k);
+            const T* q = p + g_.strides[static_cast<std::size_t>(axis)];
+            for (std::size_t c = 0; c < 3; ++c) {
+                const std::int64_t st = g_.strides[c];
+                ga[c] = difference(p[st], p[-st], scale) * half_inverse_step_[c];
+                gb[c] = difference(q[st], q[-st], scale) * half_inverse_step_[c];
+            }
+        } else {
+            ga = gradient(i, j, k, scale);
+            gb = gradient(i + (axis == 0), j + (axis == 1), k + (axis == 2), scale);
+        }
+        return {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])};
+    }
+
+    /// scale * hi - scale * lo, as gradient() computes it: for integers at scale 1 (always, but
+    /// for frames near the double range) the exact difference.
+    static double difference(T hi, T lo, double scale)
+    {
+        if constexpr (std::is_integral_v<T>) {
+            using Wide = std::conditional_t<(sizeof(T) < 4), int, std::int64_t>;
+            if (scale == 1) return static_cast<double>(static_cast<Wide>(hi) - static_cast<Wide>(lo));
+        }
+        return scale * static_cast<double>(hi) - scale * static_cast<double>(lo);
     }
 
     /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them.
@@ -781,11 +842,7 @@ private:
         for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
         const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
         write_position(x, &out.positions[v * 3]);
-        if (out.normals) {
-            const auto ga = gradient(i, j, k, e.gradient_scale), gb = gradient(end[0], end[1], end[2], e.gradient_scale);
-            write_normal(&out.normals[v * 3],
-                         {ga[0] + t * (gb[0] - ga[0]), ga[1] + t * (gb[1] - ga[1]), ga[2] + t * (gb[2] - ga[2])});
-        }
+        if (out.normals) write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale));
         if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
         if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
         if (out.vertex_values) {
@@ -811,24 +868,34 @@ private:
                 len = std::sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
             }
         }
-        for (int c = 0; c < 3; ++c) out[c] = len > 0 ? static_cast<float>(-g[static_cast<std::size_t>(c)] / len) : 0.0f;
+        if (!(len > 0)) {
+            out[0] = out[1] = out[2] = 0.0f; // a flat field: no direction
+            return;
+        }
+        const double minus_inverse = -1 / len; // one divide, then multiplies
+        for (std::size_t c = 0; c < 3; ++c) out[c] = static_cast<float>(g[c] * minus_inverse);
     }
 
     /// The cells of cell row (j, k): interior vertices from id `vertex` on and triangles from id
-    /// `tri` on; both are left one past the last written.
+    /// `tri` on; both are left one past the last written. Cells with a test take the next of
+    /// count's decisions, from `decision` on.
     void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& vertex,
-                        std::int64_t& tri) const
+                        std::int64_t& tri, std::size_t& decision) const
     {
         // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
         std::int64_t unused = 0;
         const std::uint32_t* ids[4] = {row_ids(j, k, s, e, unused), row_ids(j + 1, k, s, e, unused),
                                        row_ids(j, k + 1, s, e, unused), row_ids(j + 1, k + 1, s, e, unused)};
+        // cube edge q of the cell at i has its vertex id at edge_ids[q][3 * i]
+        const std::uint32_t* edge_ids[12];
+        for (std::size_t q = 0; q < 12; ++q) edge_ids[q] = ids[kEdgeRow[q]] + kEdgeSlot[q];
         const Word* f00 = flags(j, k, s);
         const Word* f10 = flags(j + 1, k, s);
         const Word* f01 = flags(j, k + 1, s);
         const Word* f11 = flags(j + 1, k + 1, s);
         const RowSpan r = span_of(e.c, j, k);
         const MeshSpans& out = e.out;
+        const std::vector<std::uint8_t>& decisions = e.c.decisions_;
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
@@ -838,31 +905,38 @@ private:
             const int bit = std::countr_zero(bits);
             const std::int64_t i = 64 * w + bit;
             const unsigned code = cell_code(f00, f10, f01, f11, w, bit);
-            int subcase = 0;
-            const detail::Tiling& tl = tiling_of(i, j, k, code, subcase);
-            if (vertex + tl.interior_count > e.off.first_vertex + r.v1 ||
-                tri + tl.triangle_count > e.off.first_triangle + r.t1) {
+            const detail::Tiling* tl = &detail::kVariants[detail::kVariantOffset[code]].tilings[0];
+            if (needs_values_[code]) {
+                tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
+                ++decision;
+            }
+            if (tl == nullptr || vertex + tl->interior_count > e.off.first_vertex + r.v1 ||
+                tri + tl->triangle_count > e.off.first_triangle + r.t1) {
                 throw_mismatch("cells", j, k); // before writing past the row's part of the output
             }
-            const std::int64_t first_interior = vertex;
-            if (tl.interior_count > 0) write_interior_vertices(i, j, k, tl, vertex, e);
-            vertex += tl.interior_count;
-            const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3];
+            const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
             const auto t0 = static_cast<std::size_t>(tri - out.first_triangle);
             std::uint32_t* o = &out.triangles[t0 * 3];
-            for (int q = 0; q < 3 * tl.triangle_count; ++q) {
-                const int v = codes[q];
-                o[q] = v < 12 ? ids[kEdgeRow[static_cast<std::size_t>(v)]][3 * i + kEdgeSlot[static_cast<std::size_t>(v)]]
-                              : static_cast<std::uint32_t>(first_interior + (v - 12));
+            const int n = 3 * tl->triangle_count;
+            if (tl->interior_count == 0) {
+                for (int q = 0; q < n; ++q) o[q] = edge_ids[codes[q]][3 * i];
+            } else {
+                const std::int64_t first_interior = vertex;
+                write_interior_vertices(i, j, k, *tl, vertex, e);
+                vertex += tl->interior_count;
+                for (int q = 0; q < n; ++q) {
+                    const int v = codes[q];
+                    o[q] = v < 12 ? edge_ids[v][3 * i] : static_cast<std::uint32_t>(first_interior + (v - 12));
+                }
             }
             if (mirrored_) {
-                for (int q = 0; q < 3 * tl.triangle_count; q += 3) std::swap(o[q + 1], o[q + 2]);
+                for (int q = 0; q < n; q += 3) std::swap(o[q + 1], o[q + 2]);
             }
             if (out.triangle_cells) {
                 const std::int64_t cell = i + nx_ * (j + ny_ * k);
-                for (int q = 0; q < tl.triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
+                for (int q = 0; q < tl->triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
-            tri += tl.triangle_count;
+            tri += tl->triangle_count;
           }
         }
     }
@@ -930,6 +1004,7 @@ private:
     Mat3 m_;                  ///< index to world: M = D * diag(spacing)
     bool diagonal_, mirrored_; ///< M diagonal; det M < 0 (triangles are reversed)
     double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
+    double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
     std::array<bool, 256> needs_values_{};

@@ -39,7 +39,8 @@
 namespace cmc33 {
 
 /// What count() found in one range: the number of vertices and triangles, and per sample row the
-/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row.
+/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row and
+/// one per cell with a face or interior test (its decision, which emit() replays).
 class RangeCounts {
 public:
     std::int64_t k0() const noexcept { return k0_; }
@@ -62,6 +63,9 @@ private:
     double largest_sample_ = 0;            ///< bound on |sample| near the range (normals' scaling)
     std::vector<Row> rows_;                ///< (k1 - k0) * ny rows, row (j, k) at j + (k - k0) * ny
     std::vector<std::int64_t> seam_first_; ///< plane k1's rows: first x/y edge vertex (next range's ids)
+    /// One byte per cell with a face or interior test, in the order count met them: its decision,
+    /// which emit replays instead of deciding again
+    std::vector<std::uint8_t> decisions_;
     ExtractStats stats_{};
 };
 
