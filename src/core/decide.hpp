@@ -40,7 +40,7 @@ inline thread_local bool filter_uncertain = false;
 struct Filtered {
     double v = 0, e = 0;
     Filtered() = default;
-    Filtered(double x) : v(x) {} // NOLINT: exact conversion
+    constexpr Filtered(double x) : v(x) {} // NOLINT: exact conversion
     Filtered(double x, double err) : v(x), e(err) {}
     static constexpr double kRel = 0x1p-50;
     friend Filtered operator+(Filtered a, Filtered b)
@@ -115,6 +115,8 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
 /// iso - eps, exactly the sign rule, so exact ties (integer data at an integer isovalue) are decided
 /// as the verifier sees them. Products drop eps^2: F's eps^2 terms cancel, and t_max is linear in eps.
 template <class R> struct EpsT {
+    using Real = R;
+    static constexpr bool kHasEps = true;
     R x{}, y{};
     friend EpsT operator+(const EpsT& a, const EpsT& b) { return {a.x + b.x, a.y + b.y}; }
     friend EpsT operator-(const EpsT& a, const EpsT& b) { return {a.x - b.x, a.y - b.y}; }
@@ -126,6 +128,33 @@ template <class R> struct EpsT {
         return s != 0 ? s : sgn(y);
     }
     bool above() const { return sign() >= 0; } // the sign rule: zero counts as above
+};
+
+/// EpsT without its eps part, for a first, cheaper pass in filtered arithmetic: where no sign is 0
+/// the eps terms decide nothing, and the answer is EpsT's (the x parts are the same numbers). A sign
+/// that is 0, or that rounding cannot settle, raises filter_uncertain: the caller then decides with
+/// EpsT. (y is always 0, for the few places that read it after a sign of 0 has been raised.)
+template <class R> struct NoEps {
+    using Real = R;
+    static constexpr bool kHasEps = false;
+    R x{};
+    static constexpr R y = R(0.0);
+    NoEps() = default;
+    NoEps(const R& x_, const R& /*eps part, dropped*/) : x(x_) {}
+    friend NoEps operator+(const NoEps& a, const NoEps& b) { return {a.x + b.x}; }
+    friend NoEps operator-(const NoEps& a, const NoEps& b) { return {a.x - b.x}; }
+    friend NoEps operator*(const NoEps& a, const NoEps& b) { return {a.x * b.x}; }
+    friend NoEps operator*(double k, const NoEps& a) { return {R(k) * a.x}; }
+    int sign() const
+    {
+        const int s = sgn(x);
+        if (s == 0) filter_uncertain = true;
+        return s;
+    }
+    bool above() const { return sign() >= 0; }
+
+private:
+    NoEps(const R& x_) : x(x_) {} // NOLINT: from an operation's result
 };
 
 /// The sweep of Chernyaev's interior test: planes perpendicular to `axis`, from the face holding
@@ -154,12 +183,12 @@ using Sweep = SweepT<double>;
 /// In the slice at height t, is the region of corner A joined to that of corner C? Both must have
 /// A0's sign; through B or D when one of them has it too, else by the slice's saddle (asymptotic
 /// decider; a saddle equal to iso is above).
-template <class R> bool slice_joins(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
+template <class E> bool slice_joins(const SweepT<E>& s, const E& t)
 {
-    using S = SweepT<EpsT<R>>;
+    using S = SweepT<E>;
     const bool above = s.A0.above();
-    const EpsT<R> a_t = S::at(s.A0, s.A1, t), b_t = S::at(s.B0, s.B1, t);
-    const EpsT<R> c_t = S::at(s.C0, s.C1, t), d_t = S::at(s.D0, s.D1, t);
+    const E a_t = S::at(s.A0, s.A1, t), b_t = S::at(s.B0, s.B1, t);
+    const E c_t = S::at(s.C0, s.C1, t), d_t = S::at(s.D0, s.D1, t);
     if (a_t.above() != above || c_t.above() != above) return false;
     if (b_t.above() == above || d_t.above() == above) return true;
     const int num = (a_t * c_t - b_t * d_t).sign();
@@ -172,9 +201,8 @@ template <class R> bool slice_joins(const SweepT<EpsT<R>>& s, const EpsT<R>& t)
 /// Nothing is divided: with a < 0, sign(X(t_max)) = sign((X1 - X0) b - 2a X0) and
 /// F(t_max) = (4ac - b^2) / 4a has the sign of b^2 - 4ac. On data with exact ties (integers,
 /// dyadic fractions) these are exact, so a zero is a true zero and the eps terms decide it.
-template <class R> bool chernyaev_joined(const SweepT<EpsT<R>>& s)
+template <class E> bool chernyaev_joined(const SweepT<E>& s)
 {
-    using E = EpsT<R>;
     const E a = s.a(), b = s.b(), c = s.c(); // a carries no eps: it is made of differences
     if (sgn(a.x) >= 0) return false;
     if (b.sign() <= 0 || (2.0 * a + b).sign() >= 0) return false; // t_max outside (0, 1)
@@ -191,9 +219,13 @@ template <class R> bool chernyaev_joined(const SweepT<EpsT<R>>& s)
 
 /// Sign of P + Q sqrt(D), D >= 0, without rounding a square root: compare P^2 with Q^2 D. When
 /// D is an infinitesimal eps * D.y, sqrt(D) ~ sqrt(eps) outweighs any eps term.
-template <class R> int sign_p_plus_q_sqrt(const EpsT<R>& P, const EpsT<R>& Q, const EpsT<R>& D)
+template <class E> int sign_p_plus_q_sqrt(const E& P, const E& Q, const E& D)
 {
     if (sgn(D.x) == 0) {
+        if constexpr (!E::kHasEps) {
+            filter_uncertain = true; // D is its eps part: EpsT decides
+            return 0;
+        }
         if (sgn(P.x) != 0) return sgn(P.x);
         if (sgn(Q.x) != 0 && sgn(D.y) > 0) return sgn(Q.x);
         return P.sign() != 0 ? P.sign() : Q.sign();
@@ -206,11 +238,10 @@ template <class R> int sign_p_plus_q_sqrt(const EpsT<R>& P, const EpsT<R>& Q, co
 }
 
 /// Sign of l0 + l1 t at the root t = (-b + sigma sqrt(disc)) / 2a of F (a != 0).
-template <class R>
-int sign_at_root(const EpsT<R>& l0, const EpsT<R>& l1, const EpsT<R>& a, const EpsT<R>& b, const EpsT<R>& disc, int sigma)
+template <class E> int sign_at_root(const E& l0, const E& l1, const E& a, const E& b, const E& disc, int sigma)
 {
-    const EpsT<R> P = 2.0 * (a * l0) - l1 * b;
-    const EpsT<R> Q = static_cast<double>(sigma) * l1;
+    const E P = 2.0 * (a * l0) - l1 * b;
+    const E Q = static_cast<double>(sigma) * l1;
     return sign_p_plus_q_sqrt(P, Q, disc) * (sgn(a.x) > 0 ? 1 : -1);
 }
 
@@ -219,9 +250,9 @@ int sign_at_root(const EpsT<R>& l0, const EpsT<R>& l1, const EpsT<R>& a, const E
 /// the sign (+1, -1) of the slice saddle at (t1 + t2) / 2: the tunnel faces the isolated corner of
 /// that sign (Sec. 6.1.1). Every quantity is linear in t and is evaluated at the roots exactly
 /// (sign_at_root), so ties in the data cannot be decided by rounding.
-template <class R> int algorithm1(const SweepT<EpsT<R>>& s)
+template <class E> int algorithm1(const SweepT<E>& s)
 {
-    using E = EpsT<R>;
+    using R = typename E::Real;
     const E a = s.a(), b = s.b(), c = s.c();
     if (sgn(a.x) == 0) return 0; // F is at most linear: one root
     const E disc = b * b - 4.0 * (a * c);
@@ -259,9 +290,9 @@ inline double t_alt(const double* v, int edge)
 /// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 every branch is
 /// tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces joined); the
 /// legacy policy of mc33-lewiner is read from the variant (Variant::lewiner).
-template <class R> int algorithm2(const Variant& var, const EpsT<R>* ve, const double* v, Method method)
+template <class E> int algorithm2(const Variant& var, const E* ve, const double* v, Method method)
 {
-    using E = EpsT<R>;
+    using R = typename E::Real;
     if (method == Method::mc33_lewiner) {
         if (var.lewiner & kLewinerSkips) return 0; // Issue IV: never tested
         if (var.lewiner & kLewinerTAlt) {
@@ -286,10 +317,12 @@ struct Decision {
     unsigned joined; ///< the face tests: bit i for the i-th ambiguous face of the configuration
 };
 
-/// decide() in the number type R (Filtered: may raise filter_uncertain; the others: exact). `raw` are the
-/// corner samples, `v` the same minus iso rounded to double (their signs, and mc33-lewiner's
-/// t_alt); the decisions use raw - iso computed in R.
-template <class R> Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
+/// decide() in the number type R (Filtered: may raise filter_uncertain; the others: exact), with
+/// the interior tests in E (EpsT<R>, or NoEps<R> for a first filtered pass). `raw` are the corner
+/// samples, `v` the same minus iso rounded to double (their signs, and mc33-lewiner's t_alt); the
+/// decisions use raw - iso computed in R.
+template <class R, class E = EpsT<R>>
+Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
 {
     R w[8];
     for (int q = 0; q < 8; ++q) w[q] = R(raw[q]) - R(iso);
@@ -305,9 +338,9 @@ template <class R> Decision decide_in(const double* raw, double iso, const doubl
     }
     const Variant* var = &kVariants[kVariantOffset[config] + bits];
     if (var->test == kTestNone || method == Method::mc) return {var, 0, var->subcase, bits};
-    EpsT<R> ve[8];
-    for (int q = 0; q < 8; ++q) ve[q] = {w[q], R(1.0)};
-    const int tiling = algorithm2<R>(*var, ve, v, method);
+    E ve[8];
+    for (int q = 0; q < 8; ++q) ve[q] = E{w[q], R(1.0)};
+    const int tiling = algorithm2<E>(*var, ve, v, method);
     return {var, tiling, tiling != 0 ? var->tunnel_subcase : var->subcase, bits};
 }
 
@@ -336,6 +369,10 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
 #else
     (void)integers;
 #endif
+    // first without eps terms (on data without ties no sign is 0), then with them
+    filter_uncertain = false;
+    const Decision quick = decide_in<Filtered, NoEps<Filtered>>(raw, iso, v, config, method);
+    if (!filter_uncertain) return quick;
     filter_uncertain = false;
     const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method);
     if (!filter_uncertain) return filtered;

@@ -46,6 +46,7 @@
 #include "placement.hpp"
 #include "portability.hpp"
 #include "mc33_tables.hpp"
+#include "thread_pool.hpp"
 
 namespace cmc33 {
 namespace {
@@ -159,14 +160,31 @@ CMC33_ALWAYS_INLINE Word crossed_cells(const Word* a, const Word* b, const Word*
     return (any | any_next) & ~(all & all_next) & cell_valid;
 }
 
-/// The case code (bit c: corner c above, corner order of cube.hpp) of the cell at bit s of word w.
-CMC33_ALWAYS_INLINE unsigned cell_code(const Word* a, const Word* b, const Word* c, const Word* d, std::int64_t w, int s)
-{
-    const auto two = [w, s](const Word* m) {
-        return static_cast<unsigned>(((m[w] >> s) | ((m[w + 1] << 1) << (63 - s))) & 3u);
-    };
-    return two(a) | two(b) << 2 | two(c) << 4 | two(d) << 6;
-}
+/// The case codes (bit c: corner c above, corner order of cube.hpp) of the cells of word w of a
+/// cell row, from the flags of its four sample rows a (j, k), b (j + 1, k), c (j, k + 1),
+/// d (j + 1, k + 1). The words are read once, into registers (stores of counts in between could
+/// alias them), and a cell's two corners of a row are one double-word shift.
+struct CellCodes {
+    Word lo[4], hi[4];
+    CMC33_ALWAYS_INLINE CellCodes(const Word* a, const Word* b, const Word* c, const Word* d, std::int64_t w)
+        : lo{a[w], b[w], c[w], d[w]}, hi{a[w + 1], b[w + 1], c[w + 1], d[w + 1]}
+    {
+    }
+    /// The code of the cell at bit s.
+    CMC33_ALWAYS_INLINE unsigned operator()(int s) const
+    {
+        return pair(0, s) | pair(1, s) << 2 | pair(2, s) << 4 | pair(3, s) << 6;
+    }
+    /// Flags of samples s and s + 1 of row r.
+    CMC33_ALWAYS_INLINE unsigned pair(int r, int s) const
+    {
+#if CMC33_HAS_INT128
+        return static_cast<unsigned>((static_cast<detail::UInt128>(hi[r]) << 64 | lo[r]) >> s) & 3u;
+#else
+        return static_cast<unsigned>(((lo[r] >> s) | ((hi[r] << 1) << (63 - s))) & 3u);
+#endif
+    }
+};
 
 /// Words of valid bits: sample bits (below nx) or cell and x edge bits (below nx - 1).
 std::vector<Word> valid_words(std::int64_t words, std::int64_t bits)
@@ -270,7 +288,8 @@ private:
     throw Error(Status::cancelled, "extraction cancelled by the progress callback");
 }
 
-/// Runs task(0..n-1) on the caller's executor, or on one std::thread each (the first on the
+/// Runs task(0..n-1) on the caller's executor, or on the calling thread and the process's worker
+/// pool (support/thread_pool.hpp), or when that is busy on one std::thread each (the first on the
 /// calling thread); rethrows the first task's exception (by task index) once all have ended, so
 /// the error does not depend on the executor's scheduling.
 template <class Task> void run_tasks(int n, const Executor& executor, Task&& task)
@@ -287,7 +306,7 @@ template <class Task> void run_tasks(int n, const Executor& executor, Task&& tas
         executor(n, guarded);
     } else if (n == 1) {
         guarded(0);
-    } else {
+    } else if (!detail::ThreadPool::instance().try_run(n, guarded)) {
         std::vector<std::thread> pool;
         pool.reserve(static_cast<std::size_t>(n - 1));
         try {
@@ -658,9 +677,10 @@ private:
                 lo = std::min<std::int64_t>(lo, 64 * w + std::countr_zero(used));
                 hi = 64 * w + 64 - std::countl_zero(used);
             }
+            const CellCodes codes(f, fy, fz, fyz, w);
             for (Word bits = crossed; bits != 0; bits &= bits - 1) {
                 const int b = std::countr_zero(bits);
-                const unsigned code = cell_code(f, fy, fz, fyz, w, b);
+                const unsigned code = codes(b);
                 const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
                 int subcase = first.subcase;
                 const detail::Tiling* tl = &first.tilings[0];
@@ -806,6 +826,8 @@ private:
         if constexpr (std::is_integral_v<T>) {
             using Wide = std::conditional_t<(sizeof(T) < 4), int, std::int64_t>;
             if (scale == 1) return static_cast<double>(static_cast<Wide>(hi) - static_cast<Wide>(lo));
+        } else {
+            if (scale == 1) return static_cast<double>(hi) - static_cast<double>(lo); // the same numbers
         }
         return scale * static_cast<double>(hi) - scale * static_cast<double>(lo);
     }
@@ -818,14 +840,23 @@ private:
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
         for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+            // an axis at a time: on rough surfaces which of a sample's edges cross is unpredictable
             const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
-            for (Word bits = edges.any(); bits != 0; bits &= bits - 1) {
-                const int b = std::countr_zero(bits);
-                const std::int64_t i = 64 * w + b;
-                if ((edges.x >> b) & 1u) emit_edge_vertex(i, j, k, 0, ids[3 * i], e);
-                if ((edges.y >> b) & 1u) emit_edge_vertex(i, j, k, 1, ids[3 * i + 1], e);
-                if ((edges.z >> b) & 1u) emit_edge_vertex(i, j, k, 2, ids[3 * i + 2], e);
-            }
+            emit_axis_vertices<0>(edges.x, w, j, k, ids, e);
+            emit_axis_vertices<1>(edges.y, w, j, k, ids, e);
+            emit_axis_vertices<2>(edges.z, w, j, k, ids, e);
+        }
+    }
+
+    /// The vertices of the crossed edges along `axis` of samples 64 w + b of row (j, k), b a bit of
+    /// `crossed`.
+    template <int axis>
+    CMC33_ALWAYS_INLINE void emit_axis_vertices(Word crossed, std::int64_t w, std::int64_t j, std::int64_t k,
+                                                const std::uint32_t* ids, const Emit& e) const
+    {
+        for (Word bits = crossed; bits != 0; bits &= bits - 1) {
+            const std::int64_t i = 64 * w + std::countr_zero(bits);
+            emit_edge_vertex(i, j, k, axis, ids[3 * i + axis], e);
         }
     }
 
@@ -900,11 +931,12 @@ private:
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
         for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+          const CellCodes cell_codes(f00, f10, f01, f11, w);
           for (Word bits = crossed_cells(f00, f10, f01, f11, w, x_valid_[static_cast<std::size_t>(w)]); bits != 0;
                bits &= bits - 1) {
             const int bit = std::countr_zero(bits);
             const std::int64_t i = 64 * w + bit;
-            const unsigned code = cell_code(f00, f10, f01, f11, w, bit);
+            const unsigned code = cell_codes(bit);
             const detail::Tiling* tl = &detail::kVariants[detail::kVariantOffset[code]].tilings[0];
             if (needs_values_[code]) {
                 tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
@@ -949,11 +981,15 @@ private:
         const MeshSpans& out = e.out;
         T value[8];
         for (int c = 0; c < 8; ++c) value[c] = at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]);
-        double crossing_at[12][3] = {};
+        double crossing_at[12][3]; // only the needed edges' are written and read
         unsigned needed = 0;
         for (int q = 0; q < tl.interior_count; ++q) {
             const unsigned code = detail::kInteriorMasks[tl.first_interior + q];
-            for (int edge = 0; edge < 12; ++edge) needed |= static_cast<unsigned>(detail::interior_uses_edge(code, edge)) << edge;
+            if (!(code & detail::kRadialBit)) {
+                needed |= code & 0xfffu; // an edge mask
+            } else if ((code & 31u) < detail::kCornerPoint) {
+                needed |= 1u << (code & 31u); // a tube vertex over that edge's crossing
+            }
         }
         for (int edge = 0; edge < 12; ++edge) {
             if (!((needed >> edge) & 1u)) continue;
@@ -964,8 +1000,19 @@ private:
         }
         std::array<double, 3> grad[8];
         if (out.normals) {
+            const bool inside = i >= 1 && j >= 1 && k >= 1 && i + 2 < nx_ && j + 2 < ny_ && k + 2 < nz_;
             for (int c = 0; c < 8; ++c) {
-                grad[c] = gradient(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2], e.gradient_scale);
+                const std::int64_t ci = i + kCornerOffset[c][0], cj = j + kCornerOffset[c][1], ck = k + kCornerOffset[c][2];
+                if (!inside) {
+                    grad[c] = gradient(ci, cj, ck, e.gradient_scale);
+                    continue;
+                }
+                // every corner has its six neighbours: gradient()'s numbers with one bounds check
+                const T* p = g_.data + g_.offset(ci, cj, ck);
+                for (std::size_t a = 0; a < 3; ++a) {
+                    const std::int64_t st = g_.strides[a];
+                    grad[c][a] = difference(p[st], p[-st], e.gradient_scale) * half_inverse_step_[a];
+                }
             }
         }
         const double base[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
@@ -1117,7 +1164,7 @@ template <class T> Mesh extract(const GridView<T>& grid, double iso, const Extra
     // More ranges than threads, taken in turn by whichever thread is free: a surface is seldom
     // spread evenly over the planes. Ranges of at least 8 planes keep the planes read twice (at
     // the ranges' ends) few; the mesh is the same for every split.
-    const int ranges = n == 1 ? 1 : static_cast<int>(std::clamp<std::int64_t>(nz / 8, n, 4 * std::int64_t{n}));
+    const int ranges = n == 1 ? 1 : static_cast<int>(std::clamp<std::int64_t>(nz / 8, n, 8 * std::int64_t{n}));
     Ticker ticker(options.progress, 2 * nz);
 
     std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
@@ -1152,6 +1199,7 @@ template <class T> Mesh extract(const GridView<T>& grid, double iso, const Extra
     });
     if (ticker.cancelled()) throw_cancelled();
     ticker.finish();
+    if (ticker.cancelled()) throw_cancelled(); // false to the final 1 stops too: no mesh
     if (stats) {
         *stats = {};
         for (const RangeCounts& c : counts)

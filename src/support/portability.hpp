@@ -35,6 +35,7 @@ namespace cmc33::detail {
 #if defined(__SIZEOF_INT128__)
 #define CMC33_HAS_INT128 1
 __extension__ typedef __int128 Int128;
+__extension__ typedef unsigned __int128 UInt128;
 #else
 #define CMC33_HAS_INT128 0
 #endif
