@@ -344,30 +344,24 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
     return {var, tiling, tiling != 0 ? var->tunnel_subcase : var->subcase, bits};
 }
 
-/// Decides one cell with `config` not 0 or 255: in filtered double arithmetic, and where rounding
-/// could change a sign, again exactly.
-/// `raw`: the eight corner samples (corner order of cube.hpp). `integers`: try the 128-bit integer
-/// path first (the extractor passes true for integer sample types, where it nearly always applies;
-/// floating-point samples take it only after the filter could not settle a sign).
-inline Decision decide(const double* raw, double iso, unsigned config, Method method, bool integers)
+/// Decides one cell with `config` not 0 or 255: exactly in 128-bit integers when the samples and
+/// iso are small multiples of a power of two (integer data, and integer-valued floats such as CT
+/// stored as float32: their ties cost what integer data's do); otherwise in filtered double
+/// arithmetic, and where rounding could change a sign, again exactly.
+/// `raw`: the eight corner samples (corner order of cube.hpp).
+inline Decision decide(const double* raw, double iso, unsigned config, Method method)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
 #if CMC33_HAS_INT128
     // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
-    const auto exact_integers = [&](Decision& d) {
-        if (method != Method::cmc33) return false;
-        const double scale = small_integer_scale(raw, iso);
-        if (scale == 0) return false;
-        double scaled[8];
-        for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
-        d = decide_in<Int128>(scaled, iso * scale, v, config, method);
-        return true;
-    };
-    Decision d{};
-    if (integers && exact_integers(d)) return d;
-#else
-    (void)integers;
+    if (method == Method::cmc33) {
+        if (const double scale = small_integer_scale(raw, iso); scale != 0) {
+            double scaled[8];
+            for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
+            return decide_in<Int128>(scaled, iso * scale, v, config, method);
+        }
+    }
 #endif
     // first without eps terms (on data without ties no sign is 0), then with them
     filter_uncertain = false;
@@ -377,9 +371,6 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
     const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method);
     if (!filter_uncertain) return filtered;
     filter_uncertain = false;
-#if CMC33_HAS_INT128
-    if (!integers && exact_integers(d)) return d;
-#endif
     return decide_in<mpq_class>(raw, iso, v, config, method);
 }
 

@@ -632,7 +632,7 @@ private:
         for (int c = 0; c < 8; ++c) {
             raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
-        const detail::Decision d = detail::decide(raw, iso_, code, method_, std::is_integral_v<T>);
+        const detail::Decision d = detail::decide(raw, iso_, code, method_);
         subcase = d.subcase;
         decision = static_cast<std::uint8_t>(d.joined << 2 | static_cast<unsigned>(d.tiling));
         return d.variant->tilings[d.tiling];
