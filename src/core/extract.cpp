@@ -163,7 +163,7 @@ CMC33_ALWAYS_INLINE Word crossed_cells(const Word* a, const Word* b, const Word*
 /// The case codes (bit c: corner c above, corner order of cube.hpp) of the cells of word w of a
 /// cell row, from the flags of its four sample rows a (j, k), b (j + 1, k), c (j, k + 1),
 /// d (j + 1, k + 1). The words are read once, into registers (stores of counts in between could
-/// alias them), and a cell's two corners of a row are one double-word shift.
+/// alias them).
 struct CellCodes {
     Word lo[4], hi[4];
     CMC33_ALWAYS_INLINE CellCodes(const Word* a, const Word* b, const Word* c, const Word* d, std::int64_t w)
@@ -173,16 +173,12 @@ struct CellCodes {
     /// The code of the cell at bit s.
     CMC33_ALWAYS_INLINE unsigned operator()(int s) const
     {
-        return pair(0, s) | pair(1, s) << 2 | pair(2, s) << 4 | pair(3, s) << 6;
-    }
-    /// Flags of samples s and s + 1 of row r.
-    CMC33_ALWAYS_INLINE unsigned pair(int r, int s) const
-    {
-#if CMC33_HAS_INT128
-        return static_cast<unsigned>((static_cast<detail::UInt128>(hi[r]) << 64 | lo[r]) >> s) & 3u;
-#else
-        return static_cast<unsigned>(((lo[r] >> s) | ((hi[r] << 1) << (63 - s))) & 3u);
-#endif
+        if (s < 63) { // both corners of a row in its word
+            return static_cast<unsigned>((lo[0] >> s & 3u) | (lo[1] >> s & 3u) << 2 | (lo[2] >> s & 3u) << 4 |
+                                         (lo[3] >> s & 3u) << 6);
+        }
+        return static_cast<unsigned>((lo[0] >> 63) | (hi[0] & 1u) << 1 | (lo[1] >> 63) << 2 | (hi[1] & 1u) << 3 |
+                                     (lo[2] >> 63) << 4 | (hi[2] & 1u) << 5 | (lo[3] >> 63) << 6 | (hi[3] & 1u) << 7);
     }
 };
 
@@ -364,8 +360,10 @@ public:
         if (!diagonal_) normal_map_ = inverse_transpose(m_);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
-            needs_values_[code] = opt.method != Method::mc &&
-                                  (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
+            const bool tested = opt.method != Method::mc &&
+                                (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
+            fixed_tiling_[code] = tested ? nullptr : &first.tilings[0];
+            fixed_subcase_[code] = first.subcase;
         }
     }
 
@@ -622,7 +620,7 @@ private:
         return ids;
     }
 
-    /// Count's decision for crossed cell (i, j, k) with case code `code`, which needs_values_: its
+    /// Count's decision for crossed cell (i, j, k) with case code `code`, which has no fixed tiling: its
     /// tiling, its subcase, and as one byte for emit to replay, (face tests' bits << 2) | tiling
     /// (at most 6 ambiguous faces and 3 tilings).
     const detail::Tiling& decide_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, int& subcase,
@@ -636,6 +634,26 @@ private:
         subcase = d.subcase;
         decision = static_cast<std::uint8_t>(d.joined << 2 | static_cast<unsigned>(d.tiling));
         return d.variant->tilings[d.tiling];
+    }
+
+    /// Tilings of at most this many triangles are written a fixed 3 * kShortTiling ids at a time.
+    static constexpr int kShortTiling = 4;
+
+    /// kTriangleCodes followed by 3 * kShortTiling zeros, so that a short tiling's fixed-size copy
+    /// stays inside the table.
+    static const std::vector<std::uint8_t>& padded_codes()
+    {
+        static const std::vector<std::uint8_t> table = [] {
+            std::size_t n = 0;
+            for (unsigned v = 0; v < detail::kVariantOffset[256]; ++v)
+                for (const detail::Tiling& t : detail::kVariants[v].tilings) {
+                    n = std::max<std::size_t>(n, (static_cast<std::size_t>(t.first_triangle) + t.triangle_count) * 3);
+                }
+            std::vector<std::uint8_t> codes(detail::kTriangleCodes, detail::kTriangleCodes + n);
+            codes.resize(n + 3 * kShortTiling, 0);
+            return codes;
+        }();
+        return table;
     }
 
     /// The tiling a decision byte of decide_cell() names for case code `code`; null when the byte
@@ -681,10 +699,9 @@ private:
             for (Word bits = crossed; bits != 0; bits &= bits - 1) {
                 const int b = std::countr_zero(bits);
                 const unsigned code = codes(b);
-                const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
-                int subcase = first.subcase;
-                const detail::Tiling* tl = &first.tilings[0];
-                if (needs_values_[code]) {
+                int subcase = fixed_subcase_[code];
+                const detail::Tiling* tl = fixed_tiling_[code];
+                if (tl == nullptr) {
                     std::uint8_t decision = 0;
                     tl = &decide_cell(64 * w + b, j, k, code, subcase, decision);
                     c.decisions_.push_back(decision);
@@ -918,8 +935,11 @@ private:
         const std::uint32_t* ids[4] = {row_ids(j, k, s, e, unused), row_ids(j + 1, k, s, e, unused),
                                        row_ids(j, k + 1, s, e, unused), row_ids(j + 1, k + 1, s, e, unused)};
         // cube edge q of the cell at i has its vertex id at edge_ids[q][3 * i]
-        const std::uint32_t* edge_ids[12];
+        // (codes 12.. are interior vertices, never looked up here; their entries point into the
+        // rows too, so that write_short_tiling can read a few codes past a tiling's end)
+        const std::uint32_t* edge_ids[12 + detail::kMaxInteriorVertices];
         for (std::size_t q = 0; q < 12; ++q) edge_ids[q] = ids[kEdgeRow[q]] + kEdgeSlot[q];
+        for (std::size_t q = 12; q < std::size(edge_ids); ++q) edge_ids[q] = ids[0];
         const Word* f00 = flags(j, k, s);
         const Word* f10 = flags(j + 1, k, s);
         const Word* f01 = flags(j, k + 1, s);
@@ -927,6 +947,8 @@ private:
         const RowSpan r = span_of(e.c, j, k);
         const MeshSpans& out = e.out;
         const std::vector<std::uint8_t>& decisions = e.c.decisions_;
+        const std::int64_t row_end = e.off.first_triangle + r.t1;
+        const std::uint8_t* const padded_table = padded_codes().data();
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
@@ -937,8 +959,8 @@ private:
             const int bit = std::countr_zero(bits);
             const std::int64_t i = 64 * w + bit;
             const unsigned code = cell_codes(bit);
-            const detail::Tiling* tl = &detail::kVariants[detail::kVariantOffset[code]].tilings[0];
-            if (needs_values_[code]) {
+            const detail::Tiling* tl = fixed_tiling_[code];
+            if (tl == nullptr) {
                 tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
                 ++decision;
             }
@@ -951,7 +973,14 @@ private:
             std::uint32_t* o = &out.triangles[t0 * 3];
             const int n = 3 * tl->triangle_count;
             if (tl->interior_count == 0) {
-                for (int q = 0; q < n; ++q) o[q] = edge_ids[codes[q]][3 * i];
+                if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= row_end) {
+                    // always 3 * kShortTiling entries, the ones past the tiling overwritten by the
+                    // row's next cells: no loop whose length the branch predictor has to guess
+                    const std::uint8_t* padded = &padded_table[static_cast<std::size_t>(tl->first_triangle) * 3];
+                    for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = edge_ids[padded[q]][3 * i];
+                } else {
+                    for (int q = 0; q < n; ++q) o[q] = edge_ids[codes[q]][3 * i];
+                }
             } else {
                 const std::int64_t first_interior = vertex;
                 write_interior_vertices(i, j, k, *tl, vertex, e);
@@ -1054,7 +1083,10 @@ private:
     double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
-    std::array<bool, 256> needs_values_{};
+    /// Per case code: its one tiling, or null when the method decides the cell (face or interior
+    /// tests); and its subcase then.
+    std::array<const detail::Tiling*, 256> fixed_tiling_{};
+    std::array<std::uint8_t, 256> fixed_subcase_{};
 };
 
 namespace {

@@ -18,6 +18,10 @@
 
 namespace cmc33::detail {
 
+/// The most interior vertices one tiling has (the tubes of case 13.5); tests/core/test_tables.cpp
+/// checks every tiling against it.
+inline constexpr int kMaxInteriorVertices = 12;
+
 struct Tiling {
     std::uint8_t triangle_count;
     std::uint8_t interior_count;

@@ -185,7 +185,7 @@ TEST(Algorithm2, TheJoinedBranchOfCases10And12IsTestedByCmc33AndSkippedByLewiner
         }
         const int base = cmc33::detail::kBaseCase[config];
         if (base != 10 && base != 12) continue;
-        const cmc33::detail::Decision d = cmc33::detail::decide(v.data(), 0.0, config, Method::cmc33, false);
+        const cmc33::detail::Decision d = cmc33::detail::decide(v.data(), 0.0, config, Method::cmc33);
         if (!(d.variant->lewiner & cmc33::detail::kLewinerSkips)) continue;
         ++branch;
         const cmc33::CellReport lw = cmc33::analyze_cell(v, 0.0, Method::mc33_lewiner);

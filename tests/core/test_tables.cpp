@@ -106,6 +106,7 @@ TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
                 SCOPED_TRACE("config " + std::to_string(config) + " bits " + std::to_string(bits) + " tiling " + std::to_string(t));
                 const Tiling& tl = var.tilings[t];
                 ASSERT_GT(tl.triangle_count, 0);
+                ASSERT_LE(tl.interior_count, kMaxInteriorVertices);
                 std::map<std::pair<int, int>, int> directed;
                 std::set<int> verts;
                 for (int q = 0; q < tl.triangle_count; ++q) {
