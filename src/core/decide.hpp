@@ -17,6 +17,7 @@
 
 #include <gmpxx.h>
 
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <type_traits>
@@ -114,21 +115,16 @@ template <class R> bool face_joined(const R* v, bool a_above, int f)
 /// face_joined in Filtered arithmetic, written out for the case decide_in has: the four values are
 /// w = fl(sample - iso) of exact doubles (relative error at most 2^-53 each). Then AC - BD is off by
 /// at most about 4 * 2^-53 (|AC| + |BD|) plus underflow, bounded here by 2^-49 (|AC| + |BD|) + 2^-1072.
-/// Eight operations instead of Filtered's two dozen; an unsettled sign raises filter_uncertain.
-inline bool face_joined_filtered(const double* w, bool a_above, int f)
+/// Eight operations instead of Filtered's two dozen, and no branch (a face's answer is a coin toss
+/// on rough data); an unsettled sign sets `uncertain`.
+inline bool face_joined_filtered(const double* w, bool a_above, int f, bool& uncertain)
 {
     const auto p = face_cycle(f);
     const double ac = w[p[0]] * w[p[2]], bd = w[p[1]] * w[p[3]], d = ac - bd;
     const double bound = (std::abs(ac) + std::abs(bd)) * 0x1p-49 + 0x1p-1072;
-    int num = 0;
-    if (d > bound) {
-        num = 1;
-    } else if (-d > bound) {
-        num = -1;
-    } else {
-        filter_uncertain = true;
-    }
-    return a_above ? num >= 0 : num <= 0;
+    const bool positive = d > bound, negative = -d > bound;
+    uncertain |= !(positive | negative);
+    return (a_above & !negative) | (!a_above & !positive); // sign rule: a zero saddle is above
 }
 
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
@@ -351,18 +347,19 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
     unsigned bits = 0;
     if (method != Method::mc) {
         int i = 0;
-        for (int f = 0; f < 6; ++f) {
-            if (!((amb >> f) & 1u)) continue;
+        bool uncertain = false;
+        for (unsigned faces = amb; faces != 0; faces &= faces - 1, ++i) {
+            const int f = std::countr_zero(faces);
             const bool a_above = v[face_cycle(f)[0]] >= 0;
             bool joined = false;
             if constexpr (std::is_same_v<R, Filtered>) {
-                joined = face_joined_filtered(v, a_above, f); // v = fl(raw - iso): its premise
+                joined = face_joined_filtered(v, a_above, f, uncertain); // v = fl(raw - iso): its premise
             } else {
                 joined = face_joined<R>(w, a_above, f);
             }
-            if (joined) bits |= 1u << i;
-            ++i;
+            bits |= static_cast<unsigned>(joined) << i;
         }
+        if (uncertain) filter_uncertain = true;
     }
     const Variant* var = &kVariants[kVariantOffset[config] + bits];
     if (var->test == kTestNone || method == Method::mc) return {var, 0, var->subcase, bits};
