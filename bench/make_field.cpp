@@ -1,9 +1,10 @@
 // cmc33_make_field: writes the benchmark's synthetic volumes (bench/synthetic_fields.hpp) to a
-// file through the library's volume writer, so every tool of bench/run_bench.sh reads the same
+// file through the library's volume writer, so every tool of bench/run_bench.py reads the same
 // samples.
 //
 //   cmc33_make_field sines OUT.nrrd [N=512]            float32 N^3, iso 0: a large smooth surface
 //   cmc33_make_field noise OUT.nrrd [N=128] [--seed S]  float32 N^3 uniform in [-1, 1), iso 0
+//   cmc33_make_field sphere OUT.nrrd [N=256]           float32 N^3 distance to the centre - N/3
 //
 // Exit codes: 0 written, 1 the volume could not be made or written, 2 usage error.
 
@@ -27,12 +28,14 @@ constexpr std::int64_t kMaxSize = 2048; // 2048^3 float samples are 32 GiB
 constexpr const char* kUsage =
     "usage: cmc33_make_field sines OUT [N=512]\n"
     "       cmc33_make_field noise OUT [N=128] [--seed S=1]\n"
+    "       cmc33_make_field sphere OUT [N=256]\n"
     "Writes a float32 N^3 volume (2 <= N <= 2048) in the format of OUT's extension (.nrrd, .nhdr,\n"
     ".mhd, .mha, .vtk, .raw):\n"
     "  sines  f = sin(a x + 0.3) + sin(a y + 0.3) + sin(a z + 0.3), a = 2 pi * 8 / N (8 periods\n"
     "         per axis); at iso 0 a large smooth surface\n"
     "  noise  samples uniform in [-1, 1) from std::mt19937_64(S); at iso 0 nearly every cell is\n"
-    "         crossed\n";
+    "         crossed\n"
+    "  sphere f = distance to the grid's centre - N / 3; at iso 0 one sphere\n";
 
 struct UsageError {
     std::string message;
@@ -55,13 +58,13 @@ int run(const std::vector<std::string_view>& args)
         std::cout << kUsage;
         return 0;
     }
-    if (args.size() < 2) throw UsageError{"expected a field name (sines or noise) and an output file"};
+    if (args.size() < 2) throw UsageError{"expected a field name (sines, noise or sphere) and an output file"};
     const std::string_view kind = args[0];
-    if (kind != "sines" && kind != "noise") {
-        throw UsageError{"unknown field \"" + std::string(kind) + "\"; expected sines or noise"};
+    if (kind != "sines" && kind != "noise" && kind != "sphere") {
+        throw UsageError{"unknown field \"" + std::string(kind) + "\"; expected sines, noise or sphere"};
     }
     const std::string out(args[1]);
-    std::int64_t n = kind == "sines" ? 512 : 128;
+    std::int64_t n = kind == "sines" ? 512 : kind == "noise" ? 128 : 256;
     std::uint64_t seed = 1;
     bool have_n = false;
     for (std::size_t i = 2; i < args.size(); ++i) {
@@ -79,7 +82,9 @@ int run(const std::vector<std::string_view>& args)
     if (!cmc33::io::has_volume_header(out) && !out.ends_with(".raw")) {
         throw UsageError{"OUT \"" + out + "\" has no volume extension; expected .nrrd, .nhdr, .mhd, .mha, .vtk or .raw"};
     }
-    const cmc33::Volume volume = kind == "sines" ? cmc33::bench::make_sines(n) : cmc33::bench::make_noise(n, seed);
+    const cmc33::Volume volume = kind == "sines"   ? cmc33::bench::make_sines(n)
+                                 : kind == "noise" ? cmc33::bench::make_noise(n, seed)
+                                                   : cmc33::bench::make_sphere(n);
     cmc33::io::write_volume(volume, out);
     return 0;
 }

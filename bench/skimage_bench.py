@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Times scikit-image's marching cubes (Lewiner) on a NRRD volume, for bench/run_bench.sh.
+"""Times scikit-image's marching cubes (Lewiner) on a NRRD volume, for bench/run_bench.py.
 
     skimage_bench.py FILE ISO [--repeat 5]
 
@@ -140,7 +140,7 @@ class ArgumentParser(argparse.ArgumentParser):
     """Usage errors in one line, exit status 2."""
 
     def error(self, message):
-        print(f"{PROG}: {message} (try --help)", file=sys.stderr)
+        print(f"{self.prog}: {message} (try --help)", file=sys.stderr)
         sys.exit(2)
 
 

@@ -1,6 +1,6 @@
 #pragma once
 // The synthetic volumes of the benchmarks. cmc33_bench builds them in memory and cmc33_make_field
-// writes the same volumes to files for bench/run_bench.sh, so both measure the same surfaces.
+// writes the same volumes to files for bench/run_bench.py, so both measure the same surfaces.
 
 #include <cmath>
 #include <cstddef>
@@ -53,6 +53,22 @@ inline Volume make_noise(std::int64_t n, std::uint64_t seed)
         const double u = static_cast<double>(random() >> 11) * 0x1p-53;
         out[i] = static_cast<float>(2 * u - 1);
     }
+    return volume;
+}
+
+/// The distance to the grid's centre minus N / 3: at iso 0 one sphere, a smooth surface crossing
+/// few cells of a large grid.
+inline Volume make_sphere(std::int64_t n)
+{
+    Volume volume(ScalarType::f32, {n, n, n});
+    const double c = static_cast<double>(n - 1) / 2, r = static_cast<double>(n) / 3;
+    float* out = volume.samples<float>();
+    for (std::int64_t z = 0; z < n; ++z)
+        for (std::int64_t y = 0; y < n; ++y)
+            for (std::int64_t x = 0; x < n; ++x) {
+                const double dx = static_cast<double>(x) - c, dy = static_cast<double>(y) - c, dz = static_cast<double>(z) - c;
+                *out++ = static_cast<float>(std::sqrt(dx * dx + dy * dy + dz * dz) - r);
+            }
     return volume;
 }
 

@@ -11,7 +11,7 @@ packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgmp-dev libgtest-dev li
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev)
 for flag in "$@"; do
     case "$flag" in
-    --bench) packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time) ;;
+    --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
     esac
