@@ -33,8 +33,10 @@ CMC33_CORE_EXPORT std::string_view subcase_name(int subcase) noexcept;
 
 /// Runs task(0), ..., task(n - 1), possibly at the same time, and returns when all have returned.
 /// If tasks throw, it rethrows one of their exceptions after all have ended. The default
-/// (an empty Executor) starts one std::thread per task; a caller can run the tasks on its own pool
-/// (TBB, vtkSMPTools, a Python executor) instead.
+/// (an empty Executor) runs them on the calling thread and the process's pool of worker threads,
+/// which stay asleep between calls (started on first use; while another call holds the pool, a
+/// call starts threads of its own); a caller can run the tasks on its own pool (TBB,
+/// vtkSMPTools, a Python executor) instead.
 using Executor = std::function<void(int n, const std::function<void(int task)>& task)>;
 
 /// Called with the fraction of the work done, in [0, 1], from one of the tasks' threads (never two
