@@ -13,6 +13,7 @@
 #include <optional>
 #include <random>
 #include <span>
+#include <thread>
 #include <vector>
 
 #include "cmc33/error.hpp"
@@ -277,6 +278,40 @@ TEST(Passes, TheCallersExecutorRunsTheTasks)
     // an exception from the caller's side reaches the caller unchanged
     opt.executor = [](int, const std::function<void(int)>&) { throw std::runtime_error("pool is shut down"); };
     EXPECT_THROW((void)cmc33::extract(v, 100.5, opt), std::runtime_error);
+}
+
+TEST(Passes, ConcurrentAndNestedCallsShareThePoolOrStartTheirOwnThreads)
+{
+    // The default executor is a process-wide pool (support/thread_pool.hpp). Calls from several
+    // threads at once, and a call from inside another call's task, find it busy and run on
+    // threads of their own: the same meshes, no deadlock.
+    const Volume v = noise({40, 36, 48}, 11);
+    ExtractOptions opt;
+    opt.threads = 3;
+    opt.normals = true;
+    const cmc33::Mesh expected = cmc33::extract(v, 0.0, opt);
+    std::vector<std::thread> callers;
+    std::atomic<int> same{0};
+    for (int c = 0; c < 4; ++c) {
+        callers.emplace_back([&] {
+            for (int r = 0; r < 5; ++r) {
+                const cmc33::Mesh m = cmc33::extract(v, 0.0, opt);
+                same += m.triangles == expected.triangles && m.normals == expected.normals;
+            }
+        });
+    }
+    for (std::thread& t : callers) t.join();
+    EXPECT_EQ(same.load(), 20);
+
+    // nested: each of the outer call's tasks (run by the pool) extracts with threads of its own
+    std::atomic<int> nested_same{0};
+    ExtractOptions outer = opt;
+    outer.progress = [&](double) {
+        nested_same += cmc33::extract(v, 0.0, opt).triangles == expected.triangles;
+        return true;
+    };
+    EXPECT_EQ(cmc33::extract(v, 0.0, outer).triangles, expected.triangles);
+    EXPECT_GE(nested_same.load(), 1);
 }
 
 TEST(Passes, ViewsWithAnyStridesAreReadInPlace)
