@@ -936,7 +936,8 @@ private:
                                        row_ids(j, k + 1, s, e, unused), row_ids(j + 1, k + 1, s, e, unused)};
         // cube edge q of the cell at i has its vertex id at edge_ids[q][3 * i]
         // (codes 12.. are interior vertices, never looked up here; their entries point into the
-        // rows too, so that write_short_tiling can read a few codes past a tiling's end)
+        // rows too, so that the fixed-width copy of a short tiling below may read the codes past
+        // its end: it writes them into ids that the row's next cells overwrite)
         const std::uint32_t* edge_ids[12 + detail::kMaxInteriorVertices];
         for (std::size_t q = 0; q < 12; ++q) edge_ids[q] = ids[kEdgeRow[q]] + kEdgeSlot[q];
         for (std::size_t q = 12; q < std::size(edge_ids); ++q) edge_ids[q] = ids[0];
