@@ -405,13 +405,23 @@ TEST(Passes, MisuseIsRefusedBeforeAnyWrite)
     MeshSpans none;
     EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, opt, a, {}, none); }), Status::invalid_argument);
 
-    // counts of another isovalue: refused, and nothing written past the range's arrays (the
-    // guard element at the end of each)
+    // counts of another isovalue or method: refused, and nothing written past the range's arrays
+    // (the guard element at the end of each)
     for (const double other : {90.5, 100.0, 140.5}) {
-        EXPECT_EQ(status_of([&] { cmc33::emit(g, other, opt, a, {}, out); }), Status::internal) << other;
+        EXPECT_EQ(status_of([&] { cmc33::emit(g, other, opt, a, {}, out); }), Status::invalid_argument) << other;
         EXPECT_EQ(positions.back(), -1.0f) << other;
         EXPECT_EQ(triangles.back(), 7u) << other;
     }
+    ExtractOptions mc = opt;
+    mc.method = cmc33::Method::mc;
+    EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, mc, a, {}, out); }), Status::invalid_argument);
+    // samples changed between the passes: emit places count's vertices and triangles (what it
+    // classified and decided), writing nothing outside the range's arrays
+    Volume changed = bucky();
+    for (std::int64_t q = 0; q < changed.sample_count(); q += 7) changed.samples<std::uint8_t>()[q] ^= 0x55;
+    cmc33::emit(changed.view<std::uint8_t>(), 100.5, opt, a, {}, out);
+    EXPECT_EQ(positions.back(), -1.0f);
+    EXPECT_EQ(triangles.back(), 7u);
     cmc33::emit(g, 100.5, opt, a, {}, out); // the right counts: fine
     RangeOffsets huge;
     huge.first_vertex = 4294967000;
