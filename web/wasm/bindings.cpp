@@ -372,7 +372,8 @@ val analyze(const val& values, double iso, const std::string& method)
 
 /// The interior test's sweep sampled at n + 1 heights t in [0, 1] (Figs. 4 and 6 of the paper):
 /// F(t) = A_t C_t - B_t D_t, the slice saddle x_c(t) = ((A_t - D_t), (A_t - B_t)) / den(t) in the
-/// slice's own (u, v), and its value f(x_c(t)) = F(t) / den(t); on the sweep that `axis` and the
+/// slice's own (u, v), its value f(x_c(t)) = F(t) / den(t), and den(t) = A_t + C_t - B_t - D_t, whose
+/// root is the asymptote t_a of Fig. 6; on the sweep that `axis` and the
 /// tested corner `corner` give (those of analyze(): interior.axis and cornerA, or lewinerAxis and
 /// lewinerCorner). The sweep is the kernel's (SweepT of decide.hpp).
 val sweep(const val& values, double iso, int axis, int corner, int n)
@@ -385,7 +386,8 @@ val sweep(const val& values, double iso, int axis, int corner, int n)
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = c[static_cast<std::size_t>(q)] - iso;
     const cmc33::detail::Sweep s(v, axis, corner);
-    std::vector<double> t(static_cast<std::size_t>(n) + 1), f(t.size()), u(t.size()), w(t.size()), saddle(t.size());
+    std::vector<double> t(static_cast<std::size_t>(n) + 1), f(t.size()), u(t.size()), w(t.size()), saddle(t.size()),
+        dens(t.size());
     for (std::size_t k = 0; k < t.size(); ++k) {
         const double h = static_cast<double>(k) / n;
         const double den = s.den(h);
@@ -396,6 +398,7 @@ val sweep(const val& values, double iso, int axis, int corner, int n)
         u[k] = (a_t - d_t) / den;
         w[k] = (a_t - b_t) / den;
         saddle[k] = f[k] / den;
+        dens[k] = den;
     }
     val o = val::object();
     o.set("t", copy_of(t.data(), t.size()));
@@ -403,6 +406,7 @@ val sweep(const val& values, double iso, int axis, int corner, int n)
     o.set("u", copy_of(u.data(), u.size()));
     o.set("v", copy_of(w.data(), w.size()));
     o.set("saddle", copy_of(saddle.data(), saddle.size()));
+    o.set("den", copy_of(dens.data(), dens.size()));
     return o;
 });
 }
