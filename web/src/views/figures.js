@@ -67,6 +67,7 @@ export function figuresView(root, cmc33, state, setState) {
   dataFiles().then((list) => {
     for (const f of list) select.append(el('option', { value: f.file }, `${f.volume} (${f.rows} rows)`));
     if (!file && list.length) file = list[0].file;
+    if (file && !list.some((f) => f.file === file)) select.append(el('option', { value: file }, file));
     if (file) {
       select.value = file;
       load(file);
@@ -128,7 +129,7 @@ export function figuresView(root, cmc33, state, setState) {
       plots.push(linePlot(fig13, {
         x: isos,
         series: others.map((m) => ({ label: `${m} − cmc33`, values: byMethod[m].map((r, i) => (r && reference[i] ? r.b0 - reference[i].b0 : NaN)), color: color(methods.indexOf(m)), points: true })),
-        xLabel: 'isovalue', yLabel: 'extra components', width: 560, height: 280, onCursor: showHover, onClick,
+        xLabel: 'isovalue', yLabel: 'extra components', width: 520, height: 280, onCursor: showHover, onClick,
       }));
     } else {
       fig13.textContent = 'This sweep has no cmc33 rows to compare with.';
@@ -136,9 +137,10 @@ export function figuresView(root, cmc33, state, setState) {
     plots.push(linePlot(fig14, {
       x: isos,
       series: methods.map((m) => ({ label: m, values: byMethod[m].map((r) => (r ? r.non_manifold_edges : NaN)), color: color(methods.indexOf(m)), points: true })),
-      xLabel: 'isovalue', yLabel: 'non-manifold edges', width: 560, height: 280, onCursor: showHover, onClick,
+      xLabel: 'isovalue', yLabel: 'non-manifold edges', width: 520, height: 280, onCursor: showHover, onClick,
     }));
-    window.cmc33Page.figures = { isos, methods, fig13: plots.length === 2 ? plots[0].data : null, fig14: plots[plots.length - 1].data };
+    // for the browser tests: the plots' own data, which must be the sweep file's numbers
+    window.cmc33Page.figures = { isos, methods, fig13: plots.length === 2 ? plots[0] : null, fig14: plots[plots.length - 1] };
   }
 
   async function extractAt(value) {
