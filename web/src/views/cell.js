@@ -149,7 +149,7 @@ export function cellView(root, cmc33, state, setState) {
 
   function showFaces(r) {
     faces.replaceChildren(
-      el('tr', {}, el('th', {}, 'face'), el('th', {}, 'ambiguous'), el('th', {}, 'saddle value'), el('th', {}, 'above corners joined')),
+      el('tr', {}, el('th', {}, 'face'), el('th', {}, 'ambiguous'), el('th', {}, 'saddle value − iso'), el('th', {}, 'above corners joined')),
       ...r.faces.map((f, i) =>
         el('tr', { dataset: { face: i } }, el('td', {}, FACE_NAMES[i]), el('td', {}, f.ambiguous ? 'yes' : 'no'),
           el('td', {}, f.ambiguous && f.used ? fmt(f.saddle + 0) : '—'),
