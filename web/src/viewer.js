@@ -51,7 +51,7 @@ export class Viewer {
     if (box.isEmpty()) return;
     const center = box.getCenter(new THREE.Vector3());
     const size = box.getSize(new THREE.Vector3()).length();
-    this.camera.position.copy(center).add(new THREE.Vector3(0.55, -0.95, 0.75).multiplyScalar(size * 0.85));
+    this.camera.position.copy(center).add(new THREE.Vector3(0.55, -0.95, 0.75).multiplyScalar(size * 1.0));
     this.camera.up.set(0, 0, 1);
     this.camera.near = size / 1000;
     this.camera.far = size * 100;

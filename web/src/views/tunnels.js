@@ -10,13 +10,29 @@ import { takeMesh } from '../cmc33.js';
 
 const N = 5;
 
+/** The mesh's triangles whose centroid lies in the pair's two cells, and the others. */
+function split(mesh, pair) {
+  const lo = pair.a.map((x, i) => Math.min(x, pair.b[i])), hi = pair.a.map((x, i) => Math.max(x, pair.b[i]) + 1);
+  const inside = [], outside = [];
+  const t = mesh.triangles, p = mesh.positions;
+  for (let f = 0; f < t.length; f += 3) {
+    let ok = true;
+    for (let a = 0; a < 3; ++a) {
+      const c = (p[3 * t[f] + a] + p[3 * t[f + 1] + a] + p[3 * t[f + 2] + a]) / 3;
+      ok &&= c > lo[a] && c < hi[a];
+    }
+    (ok ? inside : outside).push(t[f], t[f + 1], t[f + 2]);
+  }
+  return [new Uint32Array(inside), new Uint32Array(outside)];
+}
+
 export function tunnelsView(root, cmc33, state, setState) {
   const methods = cmc33.methods();
   let seed = Number.isInteger(Number(state.seed)) ? Number(state.seed) : FIG8_SEED;
   const claim = el('p', { class: 'claim' },
     'Fig. 8 of the paper: "when neighbor voxels have tunnels in their interiors, and share an ambiguous, coplanar face, ' +
     'the end result will be non-manifold edges". Below, every method of the library extracts the same 5³ field. ' +
-    'The two cells with tunnels are outlined, their shared face is purple, and non-manifold edges (more than two ' +
+    'The two cells with tunnels are drawn solid (the rest of the surface faint), their shared face is purple, and non-manifold edges (more than two ' +
     'triangles) are drawn in pink. The last columns compare each mesh with the topology of the trilinear field ' +
     'itself (cmc33::field_topology, which shares no code with the extractor).');
   const info = el('div', { id: 'tunnels-info' });
@@ -63,7 +79,10 @@ export function tunnelsView(root, cmc33, state, setState) {
           el('td', { class: t.nonManifoldEdges > 0 ? 'bad' : '' }, String(t.nonManifoldEdges)),
           el('td', {}, `${t.euler}`), el('td', {}, `${t.b0}, ${t.b1}, ${t.b2}`), el('td', {}, String(t.boundaryLoops)),
           el('td', { class: same ? 'good' : 'bad' }, same ? 'equal' : 'differs')));
-        objects.push(surface(mesh.positions, mesh.triangles, { color: COLORS.surface, offset }));
+        // the two cells' triangles opaque, the rest of the field faint, so that the tunnels show
+        const [inside, outside] = pair ? split(mesh, pair) : [mesh.triangles, new Uint32Array(0)];
+        if (inside.length) objects.push(surface(mesh.positions, inside, { color: COLORS.surface, offset }));
+        if (outside.length) objects.push(surface(mesh.positions, outside, { color: 0x9aa5b1, opacity: 0.18, offset }));
         objects.push(boxEdges(offset, [offset[0] + N - 1, N - 1, N - 1], 0xbbbbbb));
         const ends = [];
         for (let e = 0; e < mesh.nonManifoldEdges.length; e += 2) {
