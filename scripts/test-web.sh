@@ -11,4 +11,4 @@ if [[ ! -f build/build.ninja ]]; then
 fi
 cmake --build build -j2 --target cmc33_cli
 cd web
-node --no-experimental-fetch --test test/
+node --no-experimental-fetch --test test/wasm.test.mjs test/browser.test.mjs
