@@ -218,9 +218,13 @@ void PortableInflater::finish_member()
     buffer_ >>= skip;
     bits_ -= skip;
     if (gzip_) {
-        const std::uint32_t crc = bits(16) | bits(16) << 16;
+        const auto little_endian_32 = [this] {
+            const std::uint32_t low = bits(16); // two statements: the order of the reads is fixed
+            return low | bits(16) << 16;
+        };
+        const std::uint32_t crc = little_endian_32();
         if (crc != crc_) corrupt("incorrect data check");
-        const std::uint32_t size = bits(16) | bits(16) << 16;
+        const std::uint32_t size = little_endian_32();
         if (size != static_cast<std::uint32_t>(member_bytes_)) corrupt("incorrect length check");
     } else {
         std::uint32_t adler = 0;
