@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz]
+# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz] [--web]
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --web    also emscripten, node and npm, and chromium for the page's browser tests (web/)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
@@ -13,7 +14,14 @@ for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
+    --web)
+        # node-acorn: emscripten's optimizer requires it. node and npm only where there are none
+        # (a node from elsewhere, with its own npm, is kept).
+        packages+=(emscripten node-acorn chromium)
+        command -v node >/dev/null || packages+=(nodejs)
+        command -v npm >/dev/null || packages+=(npm)
+        ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz or --web" >&2; exit 2 ;;
     esac
 done
 

@@ -11,19 +11,26 @@
 // its bound (a tie, or a near-tie such as decimal data whose exact sum is 0 but rounds to 1e-17),
 // the cell is decided again exactly on the same doubles: in 128-bit integers when the values are
 // small multiples of a power of two (integer-valued floats, halves, quarters: the common ties,
-// decided without allocating), else in rational arithmetic (GMP's mpq_class). Nothing throws: an
-// unsettled sign raises a per-thread flag that decide() reads once per cell.
+// decided without allocating), else in rational arithmetic (GMP's mpq_class; in a build without
+// GMP, CMC33_WITH_GMP=0 such as the WebAssembly one, in Shewchuk expansions, see decide_expansion).
+// Nothing throws but that build's expansions out of range: an unsettled sign raises a per-thread
+// flag that decide() reads once per cell.
 // So the extractor and the verifier, which decides exactly too, see the same field.
 
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
 #include <gmpxx.h>
+#endif
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
 #include <type_traits>
 
+#include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cube.hpp"
+#include "expansion.hpp"
 #include "mc33_tables.hpp"
 #include "portability.hpp"
 
@@ -71,7 +78,16 @@ inline int sgn(const Filtered& f)
     if (!(f.v == 0 && f.e == 0)) filter_uncertain = true;
     return 0;
 }
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
 inline int sgn(const mpq_class& q) { return mpq_sgn(q.get_mpq_t()); }
+#endif
+/// Raised by the sign of an Expansion that under- or overflowed (decide_expansion throws then).
+inline thread_local bool expansion_lost = false;
+inline int sgn(const Expansion& x)
+{
+    if (x.lost()) expansion_lost = true;
+    return x.sign();
+}
 
 /// Exact for small integers: with |value - iso| <= 2^15 every polynomial of a decision stays below
 /// 2^111 (the largest, P^2 - Q^2 disc of Algorithm 1, is at most 2^14 * |v|^6), far inside 2^127.
@@ -369,6 +385,38 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
     return {var, tiling, tiling != 0 ? var->tunnel_subcase : var->subcase, bits};
 }
 
+/// decide_in<Expansion>: the exact decision without GMP. The decisions are homogeneous polynomials
+/// (degree <= 6) in the values minus iso, so all samples and iso are first scaled by one power of
+/// two that brings the largest magnitude just below 1: exact, sign-preserving, and it keeps every
+/// product away from overflow, and from underflow unless the nine numbers' magnitudes lie more than
+/// about 2^100 apart (a degree-6 product of the smallest then falls below 2^-969: 1e-30 beside 1
+/// at a near-tie). There the expansions lose exactness, and this throws rather than return a
+/// decision that might be wrong.
+inline Decision decide_expansion(const double* raw, double iso, const double* v, unsigned config, Method method)
+{
+    double largest = std::abs(iso);
+    for (int q = 0; q < 8; ++q) largest = std::max(largest, std::abs(raw[q]));
+    int exponent = 0;
+    (void)std::frexp(largest, &exponent); // largest in [2^(exponent-1), 2^exponent)
+    double scaled[8];
+    bool exact = true;
+    for (int q = 0; q < 8; ++q) {
+        scaled[q] = std::ldexp(raw[q], -exponent);
+        exact = exact && std::ldexp(scaled[q], exponent) == raw[q];
+    }
+    const double scaled_iso = std::ldexp(iso, -exponent);
+    exact = exact && std::ldexp(scaled_iso, exponent) == iso;
+    expansion_lost = false;
+    const Decision d = decide_in<Expansion>(scaled, scaled_iso, v, config, method);
+    if (!exact || expansion_lost) {
+        expansion_lost = false;
+        throw Error(Status::internal, "a cell's decision needs exact arithmetic beyond this build's range (corner values "
+                                      "and isovalue whose magnitudes lie more than about 2^100 apart, at a near-tie); "
+                                      "a build with GMP decides it");
+    }
+    return d;
+}
+
 /// Decides one cell with `config` not 0 or 255: exactly in 128-bit integers when the samples and
 /// iso are small multiples of a power of two (integer data, and integer-valued floats such as CT
 /// stored as float32: their ties cost what integer data's do); otherwise in filtered double
@@ -396,7 +444,11 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
     const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method);
     if (!filter_uncertain) return filtered;
     filter_uncertain = false;
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
     return decide_in<mpq_class>(raw, iso, v, config, method);
+#else
+    return decide_expansion(raw, iso, v, config, method);
+#endif
 }
 
 } // namespace cmc33::detail

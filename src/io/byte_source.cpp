@@ -13,7 +13,11 @@
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
 #include <zlib.h>
+#else
+#include "inflate_portable.hpp"
+#endif
 
 #include "cmc33/error.hpp"
 
@@ -215,6 +219,7 @@ void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const
 
 namespace {
 
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
 /// Pulls bytes out of the stream(s) in `in`, one caller buffer at a time.
 class Inflater {
 public:
@@ -296,6 +301,9 @@ private:
     std::size_t fed_ = 0;
     bool ended_ = false;
 };
+#else
+using Inflater = PortableInflater; // the same contract, without zlib (inflate_portable.hpp)
+#endif
 
 } // namespace
 

@@ -12,6 +12,10 @@ namespace cmc33::detail {
 
 inline int resolve_threads(int requested)
 {
+#if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
+    (void)requested;
+    return 1; // a WebAssembly build without pthreads has one thread: the pools are never used
+#endif
     if (requested > 0) return requested;
     const unsigned hw = std::thread::hardware_concurrency();
     return hw == 0 ? 1 : static_cast<int>(hw);

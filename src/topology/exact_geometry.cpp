@@ -4,8 +4,14 @@
 
 #include <cmath>
 #include <cstddef>
-#include <gmpxx.h>
 #include <limits>
+
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
+#include <gmpxx.h>
+#else
+#include "cmc33/error.hpp"
+#include "expansion.hpp"
+#endif
 
 namespace cmc33::detail {
 namespace {
@@ -71,25 +77,42 @@ bool exact_differences(const double* a, const double* b, double* out, int n)
     return true;
 }
 
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
+using Exact = mpq_class;
+int exact_sign(const mpq_class& q) { return sgn(q); }
+#else
+// Without GMP (the WebAssembly build): Shewchuk expansions. Mesh coordinates are floats, whose
+// degree-3 products stay far from the expansions' underflow; should they not, say so.
+using Exact = Expansion;
+int exact_sign(const Expansion& x)
+{
+    if (x.lost()) {
+        throw Error(Status::internal, "an exact geometric predicate left the range of this build's expansions "
+                                      "(coordinates far beyond the float range); a build with GMP decides it");
+    }
+    return x.sign();
+}
+#endif
+
 int orient3d_rational(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
 {
-    mpq_class m[3][3];
+    Exact m[3][3];
     const Point3* rows[3] = {&a, &b, &c};
     for (int r = 0; r < 3; ++r)
         for (int k = 0; k < 3; ++k) {
             const auto kk = static_cast<std::size_t>(k);
-            m[r][k] = mpq_class((*rows[r])[kk]) - mpq_class(d[kk]);
+            m[r][k] = Exact((*rows[r])[kk]) - Exact(d[kk]);
         }
-    const mpq_class det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
-                          m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
-                          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    return sgn(det);
+    const Exact det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+                      m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+                      m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    return exact_sign(det);
 }
 
 int orient2d_rational(double ax, double ay, double bx, double by, double cx, double cy)
 {
-    const mpq_class det = (mpq_class(ax) - cx) * (mpq_class(by) - cy) - (mpq_class(ay) - cy) * (mpq_class(bx) - cx);
-    return sgn(det);
+    const Exact det = (Exact(ax) - Exact(cx)) * (Exact(by) - Exact(cy)) - (Exact(ay) - Exact(cy)) * (Exact(bx) - Exact(cx));
+    return exact_sign(det);
 }
 
 } // namespace

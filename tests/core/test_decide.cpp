@@ -2,7 +2,9 @@
 // values allow, else filtered doubles without eps terms, with them, and rationals) must give, for
 // every cell, the decision of decide_in<mpq_class>, which computes every sign exactly. The cells are
 // built to sit on and near the filters' edges: exact ties, dyadic and decimal values, values that
-// differ in their last bits, tiny and huge magnitudes.
+// differ in their last bits, tiny and huge magnitudes. The exact fallback of builds without GMP
+// (decide_expansion: Shewchuk expansions on values scaled by a power of two) must give the
+// rationals' decision on every one of them too.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +12,7 @@
 #include <random>
 #include <string>
 
+#include "cmc33/error.hpp"
 #include "decide.hpp"
 
 namespace {
@@ -45,6 +48,15 @@ template <class Draw> int compare(Draw&& draw, double iso, int cells, std::uint6
         for (const Method method : {Method::cmc33, Method::mc33_lewiner}) {
             const Decision got = cmc33::detail::decide(raw, iso, config, method);
             const Decision want = exact(raw, iso, config, method);
+            double v[8];
+            for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+            const Decision expansion = cmc33::detail::decide_expansion(raw, iso, v, config, method);
+            if (expansion.variant != want.variant || expansion.tiling != want.tiling || expansion.joined != want.joined) {
+                ADD_FAILURE() << what << ", cell " << n << " (" << cmc33::method_name(method)
+                              << "): decide_expansion gives subcase " << expansion.subcase << " tiling "
+                              << expansion.tiling << ", exactly " << want.subcase << " tiling " << want.tiling;
+                return tested;
+            }
             if (got.variant != want.variant || got.tiling != want.tiling || got.subcase != want.subcase) {
                 std::string values;
                 for (const double x : raw) values += " " + std::to_string(x);
@@ -92,8 +104,9 @@ TEST(Decide, FilteredDecisionsAreTheExactOnes)
             double raw[8];
             for (double& x : raw) x = iso + any(rng);
             raw[p[0]] = iso + u(rng), raw[p[2]] = iso + u(rng), raw[p[3]] = iso - u(rng);
-            const long double l_iso = iso;
-            double b = static_cast<double>(l_iso + (raw[p[0]] - l_iso) * (raw[p[2]] - l_iso) / (raw[p[3]] - l_iso));
+            const auto l_iso = static_cast<long double>(iso);
+            const auto l = [&](int q) { return static_cast<long double>(raw[p[static_cast<std::size_t>(q)]]); };
+            double b = static_cast<double>(l_iso + (l(0) - l_iso) * (l(2) - l_iso) / (l(3) - l_iso));
             for (int step = static_cast<int>(rng() % 9); step > 0; --step) b = std::nextafter(b, rng() % 2 ? 1.0 : -1.0);
             raw[p[1]] = b;
             cells += compare([&, q = 0](auto&) mutable { return raw[q++]; }, iso, 1, 0, "near-singular face");
@@ -105,6 +118,34 @@ TEST(Decide, FilteredDecisionsAreTheExactOnes)
             "tiny");
     compare([](auto& r) { return std::ldexp(std::uniform_real_distribution<double>(-1, 1)(r), 500); }, 0.0, 5000, 7,
             "huge");
+}
+
+TEST(Decide, ExpansionFallbackRefusesWhatItCannotDecide)
+{
+    // An ambiguous face whose below corners are 2^-600 and above ones 1: the product of the below
+    // pair, 2^-1200, underflows the expansions, so the fallback says so instead of deciding.
+    const auto p = cmc33::detail::face_cycle(0);
+    double raw[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+    raw[p[0]] = 1, raw[p[2]] = 1, raw[p[1]] = -0x1p-600, raw[p[3]] = -0x1p-600;
+    const double iso = 0;
+    const unsigned config = config_of(raw, iso);
+    ASSERT_NE(cmc33::detail::kAmbiguousFaces[config] & 1u, 0u);
+    double v[8];
+    for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+    try {
+        (void)cmc33::detail::decide_expansion(raw, iso, v, config, Method::cmc33);
+        ADD_FAILURE() << "decided a face whose products underflow";
+    } catch (const cmc33::Error& e) {
+        EXPECT_EQ(e.status(), cmc33::Status::internal);
+        EXPECT_NE(std::string(e.what()).find("beyond this build's range"), std::string::npos) << e.what();
+    }
+    // Scaled to sit near 1, the same face at 2^-30 is decided, and as the rationals decide it.
+    raw[p[1]] = -0x1p-30, raw[p[3]] = -0x1p-30;
+    for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+    const Decision d = cmc33::detail::decide_expansion(raw, iso, v, config, Method::cmc33);
+    const Decision want = exact(raw, iso, config, Method::cmc33);
+    EXPECT_EQ(d.variant, want.variant);
+    EXPECT_EQ(d.joined, want.joined);
 }
 
 } // namespace
