@@ -717,6 +717,10 @@ private:
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s, c, n1) : f;
         const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s, c, n2) : f;
         const Word* fyz = cells ? flags(j + 1, k + 1, s, c, n3) : f;
+        if (s.scan.non_finite) {
+            // before any cell of these rows is decided (a NaN has no sign): name the first one
+            scan_samples(g_, c.k0_, std::min(c.k1_, nz_ - 1));
+        }
         if (n0 != SliceMasks::kMixed && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
         RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
         std::uint32_t xy = 0, z = 0;

@@ -317,6 +317,30 @@ TEST(Extract, RejectsNonFiniteAndTooSmallGrids)
     }
     EXPECT_THROW(cmc33::extract(sphere(5, 1), std::nan("")), cmc33::Error);
     EXPECT_THROW(cmc33::extract(Volume(cmc33::ScalarType::u8, {1, 5, 5}), 1.0), cmc33::Error);
+
+    // a NaN in a cell with face and interior tests (f = i + j + k - 10 has ambiguous cells once a
+    // sample is NaN): refused before any decision reaches it (GMP raised SIGFPE on NaN), for every
+    // method and thread count
+    Volume d(cmc33::ScalarType::f64, {6, 5, 20});
+    double* x = d.samples<double>();
+    for (std::int64_t k = 0; k < 20; ++k)
+        for (std::int64_t j = 0; j < 5; ++j)
+            for (std::int64_t i = 0; i < 6; ++i) x[i + 6 * (j + 5 * k)] = static_cast<double>(i + j + k) - 10.0;
+    x[3 + 6 * (2 + 5 * 7)] = std::numeric_limits<double>::quiet_NaN();
+    for (const cmc33::Method method : {cmc33::Method::cmc33, cmc33::Method::mc33_lewiner, cmc33::Method::mc}) {
+        for (const int threads : {1, 3}) {
+            cmc33::ExtractOptions opt;
+            opt.method = method;
+            opt.threads = threads;
+            try {
+                cmc33::extract(d, 0.5, opt);
+                FAIL() << "no error";
+            } catch (const cmc33::Error& e) {
+                EXPECT_EQ(e.status(), cmc33::Status::non_finite);
+                EXPECT_NE(std::string(e.what()).find("(3, 2, 7)"), std::string::npos) << e.what();
+            }
+        }
+    }
 }
 
 // The mesh of cmc33 has the topology of the trilinear interpolant's level set; the earlier
