@@ -79,6 +79,7 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
     const std::span<const std::uint32_t> tri = slab.triangles, below = slab.below;
     const std::size_t tri_count = tri.size() / 3, below_count = below.size() / 3;
     SeamTopology r;
+    r.empty_ = false;
 
     // The next slab's vertices this slab's triangles use: its upper side.
     std::vector<std::uint32_t> upper;
@@ -246,7 +247,10 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
 
 SeamTopology SeamTopology::merge(const SeamTopology& a, const SeamTopology& b)
 {
+    if (a.empty_) return b;
+    if (b.empty_) return a;
     SeamTopology r;
+    r.empty_ = false;
     r.vertices_ = a.vertices_ + b.vertices_;
     r.edges_ = a.edges_ + b.edges_;
     r.faces_ = a.faces_ + b.faces_;
@@ -406,7 +410,7 @@ std::vector<std::byte> SeamTopology::serialize() const
 {
     Writer w;
     for (const std::int64_t v : {vertices_, edges_, faces_, boundary_edges_, nonmanifold_edges_, nonmanifold_vertices_,
-                                 degenerate_, std::int64_t{oriented_}, components_, closed_, loops_,
+                                 degenerate_, std::int64_t{oriented_}, std::int64_t{empty_}, components_, closed_, loops_,
                                  std::int64_t{loop_nodes_}}) {
         w.value(v);
     }
@@ -429,6 +433,7 @@ SeamTopology SeamTopology::deserialize(std::span<const std::byte> bytes)
         *v = in.value<std::int64_t>();
     }
     r.oriented_ = in.value<std::int64_t>() != 0;
+    r.empty_ = in.value<std::int64_t>() != 0;
     r.components_ = in.value<std::int64_t>();
     r.closed_ = in.value<std::int64_t>();
     r.loops_ = in.value<std::int64_t>();

@@ -44,6 +44,9 @@ public:
     /// The summary of one slab. @throws Error{invalid_argument} for a triangle of `triangles` with
     /// an id below first_vertex, or a triangle array that is not a multiple of 3.
     static SeamTopology of_slab(const SlabTriangles& slab);
+    /// The summary of no slab (a range of no planes, an MPI rank with none): merging with it
+    /// changes nothing.
+    SeamTopology() = default;
     /// The summary of `lower` followed by `upper` (neighbouring runs of slabs, lower first).
     /// @throws Error{internal} if they do not fit (a boundary flag for a seam vertex the lower run
     /// does not have: the slabs were not neighbours).
@@ -68,6 +71,7 @@ private:
     std::int64_t vertices_ = 0, edges_ = 0, faces_ = 0, boundary_edges_ = 0, nonmanifold_edges_ = 0,
                  nonmanifold_vertices_ = 0, degenerate_ = 0;
     bool oriented_ = true;
+    bool empty_ = true; ///< of no slab
     std::int64_t components_ = 0, closed_ = 0, loops_ = 0; ///< complete ones (not nodes)
     std::vector<std::uint8_t> node_boundary_;              ///< per component node: has a boundary edge
     std::int32_t loop_nodes_ = 0;
