@@ -282,7 +282,8 @@ void count_twins(const std::vector<float>& positions, std::size_t first, std::si
 
 PlyLayout::PlyLayout(std::uint64_t vertex_count, std::uint64_t triangle_count, bool normals)
     : vertices(vertex_count), triangles(triangle_count),
-      vertex_bytes(normals ? io::detail::kPlyNormalVertexBytes : io::detail::kPlyVertexBytes)
+      // as write_ply(): a mesh without vertices has no normals to declare
+      vertex_bytes(normals && vertex_count > 0 ? io::detail::kPlyNormalVertexBytes : io::detail::kPlyVertexBytes)
 {
     header_bytes = header().size();
 }
