@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz]
+# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi]
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --mpi    also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
@@ -13,7 +14,8 @@ for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
+    --mpi) packages+=(libopenmpi-dev openmpi-bin) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz or --mpi" >&2; exit 2 ;;
     esac
 done
 

@@ -66,6 +66,12 @@ public:
     PlaneStream(const PlaneStream&) = delete;
     PlaneStream& operator=(const PlaneStream&) = delete;
 
+    /// Planes read from the file so far (after the last window: all of them).
+    std::int64_t planes_read()
+    {
+        const std::lock_guard<std::mutex> lock(mutex_);
+        return planes_read_;
+    }
     /// The planes of the next window; the previous window's buffer is given back.
     const std::byte* next()
     {
@@ -88,8 +94,9 @@ private:
                     changed_.wait(lock, [&] { return stop_ || i < 2 || current_ >= static_cast<std::int64_t>(i) - 1; });
                     if (stop_) return;
                 }
-                load(i);
+                const std::int64_t planes = load(i);
                 const std::lock_guard<std::mutex> lock(mutex_);
+                planes_read_ += planes;
                 loaded_ = static_cast<std::int64_t>(i) + 1;
                 changed_.notify_all();
             }
@@ -99,7 +106,8 @@ private:
             changed_.notify_all();
         }
     }
-    void load(std::size_t i)
+    /// Fills window i's buffer; returns the number of planes read from the file.
+    std::int64_t load(std::size_t i)
     {
         const Window w = windows_[i];
         std::byte* out = buffers_[i % 2];
@@ -113,7 +121,9 @@ private:
                 from = shared_end;
             }
         }
-        if (from < w.hi) reader_.read(from, w.hi, out + static_cast<std::uint64_t>(from - w.lo) * plane_);
+        if (from >= w.hi) return 0;
+        reader_.read(from, w.hi, out + static_cast<std::uint64_t>(from - w.lo) * plane_);
+        return w.hi - from;
     }
 
     io::detail::PlaneReader& reader_;
@@ -123,6 +133,7 @@ private:
     std::mutex mutex_;
     std::condition_variable changed_;
     std::int64_t current_ = -1, loaded_ = 0;
+    std::int64_t planes_read_ = 0;
     bool stop_ = false;
     std::exception_ptr error_;
     std::thread thread_; // last: started once the rest is set up
@@ -500,6 +511,7 @@ struct RangeRun::Impl {
         }
         kept = parts.size() == 1 && !kept_counts.empty();
         for (const Part& p : parts) totals.slabs += static_cast<std::int64_t>(p.slabs.size());
+        totals.planes_read = stream.planes_read();
         return totals;
     }
 
@@ -528,6 +540,7 @@ struct RangeRun::Impl {
             tick(p.slabs.back().b - p.slabs.front().a);
         }
         writer.flush();
+        if (stream) result.planes_read = stream->planes_read();
         kept = false;
         kept_counts.clear();
         return result;

@@ -81,6 +81,7 @@ struct RangeTotals {
     std::int64_t non_finite = 0;     ///< NaN or infinite samples among the range's own planes
     Index3 first_non_finite{-1, -1, -1};
     std::int64_t slabs = 0;
+    std::int64_t planes_read = 0;    ///< planes read from the file (each once per pass, halos included)
 };
 
 /// The geometric checks of mesh_geometry() for the triangles and vertices a range owns, each
@@ -101,6 +102,7 @@ struct GeometryPart {
 struct RangeResult {
     detail::SeamTopology topology;
     GeometryPart geometry;
+    std::int64_t planes_read = 0; ///< planes read from the file (none when the count pass kept them)
 };
 
 /// MeshGeometry of a whole mesh from its parts and its topology (welded = topology when no two
