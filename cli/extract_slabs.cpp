@@ -138,6 +138,11 @@ void run_extract_slabs(const ExtractArgs& args)
     }
     report.extra["memory_limit"] = options.memory_limit;
     report.extra["slabs"] = totals.slabs;
+    report.extra["phases_seconds"] = {{"read_wait", totals.wait_seconds + result.wait_seconds},
+                                      {"count", totals.count_seconds},
+                                      {"emit", result.emit_seconds},
+                                      {"write", result.write_seconds},
+                                      {"analyse", result.analyse_seconds}};
     report.extra["peak_rss_bytes"] = peak_rss_bytes();
     print_extract_report(args, report);
 }

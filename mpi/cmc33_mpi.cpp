@@ -233,10 +233,17 @@ slabs::GeometryPart reduce_geometry(const World& w, const slabs::GeometryPart& m
 }
 
 /// Every rank's value, on rank 0.
-std::vector<long long> gather(const World& w, long long value)
+std::vector<long long> gather_counts(const World& w, long long value)
 {
     std::vector<long long> all(w.rank == 0 ? static_cast<std::size_t>(w.size) : 0);
     MPI_Gather(&value, 1, MPI_LONG_LONG, all.data(), 1, MPI_LONG_LONG, 0, MPI_COMM_WORLD);
+    return all;
+}
+
+std::vector<double> gather_seconds(const World& w, double value)
+{
+    std::vector<double> all(w.rank == 0 ? static_cast<std::size_t>(w.size) : 0);
+    MPI_Gather(&value, 1, MPI_DOUBLE, all.data(), 1, MPI_DOUBLE, 0, MPI_COMM_WORLD);
     return all;
 }
 
@@ -377,8 +384,17 @@ void run_extract(const World& w, const ExtractArgs& args)
         geometry = reduce_geometry(w, result.geometry);
     }
     const double t5 = MPI_Wtime();
-    const std::vector<long long> rss = gather(w, peak_rss_bytes());
-    const std::vector<long long> read = gather(w, mine.planes_read + result.planes_read);
+    const std::vector<long long> rss = gather_counts(w, peak_rss_bytes());
+    const std::vector<long long> read = gather_counts(w, mine.planes_read + result.planes_read);
+    // where each rank's time went (seconds): reading not hidden by the work, counting, emitting,
+    // writing, the slabs' topology and geometry, and the reduction over the ranks
+    Json per_rank = Json::object();
+    per_rank["read_wait"] = gather_seconds(w, mine.wait_seconds + result.wait_seconds);
+    per_rank["count"] = gather_seconds(w, mine.count_seconds);
+    per_rank["emit"] = gather_seconds(w, result.emit_seconds);
+    per_rank["write"] = gather_seconds(w, result.write_seconds);
+    per_rank["analyse"] = gather_seconds(w, result.analyse_seconds);
+    per_rank["reduce"] = gather_seconds(w, t5 - t4);
     const double setup = max_over_ranks(t1 - t0), count = max_over_ranks(t2 - t1), emit = max_over_ranks(t4 - t3),
                  reduce = max_over_ranks(t5 - t4), total = max_over_ranks(t5 - t0);
     if (w.rank != 0) return;
@@ -402,6 +418,7 @@ void run_extract(const World& w, const ExtractArgs& args)
     report.extra["memory_limit"] = options.memory_limit == 0 ? Json(nullptr) : Json(options.memory_limit);
     report.extra["slabs"] = slab_count;
     report.extra["phases_seconds"] = {{"setup", setup}, {"count", count}, {"emit_and_write", emit}, {"topology", reduce}};
+    report.extra["rank_seconds"] = per_rank;
     report.extra["peak_rss_bytes"] = rss;
     report.extra["read_bytes"] = read_bytes;
     cli::print_extract_report(args, report);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cctype>
 #include <cmath>
 #include <condition_variable>
@@ -24,6 +25,10 @@
 namespace cmc33::slabs {
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 /// Planes a slab's buffer holds beyond its own on each side: emit() reads one for normals, and
 /// the neighbouring cell layers the slab emits for its analysis read one more.
@@ -184,70 +189,77 @@ class RecordWriter {
 public:
     RecordWriter(ByteSink* sink, const PlyLayout& layout, std::int64_t first_vertex, std::int64_t first_triangle,
                  std::size_t piece)
-        : sink_(sink), piece_(piece), vertex_at_(layout.vertex_offset(first_vertex)),
-          face_at_(layout.face_offset(first_triangle))
+        : sink_(sink), vertices_(layout.vertex_offset(first_vertex), sink ? piece : 0),
+          faces_(layout.face_offset(first_triangle), sink ? piece : 0)
     {
     }
     void vertices(const float* positions, const float* normals, std::size_t n)
     {
         if (!sink_) return;
+        std::byte record[24];
+        const std::size_t size = normals ? 24 : 12;
         for (std::size_t v = 0; v < n; ++v) {
-            put(vertices_, vertex_at_, positions + 3 * v, 12);
-            if (normals) put(vertices_, vertex_at_, normals + 3 * v, 12);
+            std::memcpy(record, positions + 3 * v, 12);
+            if (normals) std::memcpy(record + 12, normals + 3 * v, 12);
+            if constexpr (std::endian::native == std::endian::big) swap_words(record, size / 4);
+            append(vertices_, record, size);
         }
     }
     void faces(const std::uint32_t* triangles, std::size_t n)
     {
         if (!sink_) return;
+        std::byte record[13];
+        record[0] = std::byte{3};
         for (std::size_t t = 0; t < n; ++t) {
-            std::byte record[13];
-            record[0] = std::byte{3};
             std::memcpy(record + 1, triangles + 3 * t, 12);
             if constexpr (std::endian::native == std::endian::big) swap_words(record + 1, 3);
-            append(faces_, face_at_, record, 13);
+            append(faces_, record, 13);
         }
     }
     void flush()
     {
         if (!sink_) return;
-        write(vertices_, vertex_at_);
-        write(faces_, face_at_);
+        write(vertices_);
+        write(faces_);
     }
 
 private:
+    /// One stream of records: the next file offset and the bytes staged for it.
+    struct Stage {
+        Stage(std::uint64_t offset, std::size_t piece) : at(offset), bytes(piece) {}
+        std::uint64_t at;
+        std::vector<std::byte> bytes;
+        std::size_t used = 0;
+    };
     static void swap_words(std::byte* p, std::size_t n)
     {
         for (std::size_t w = 0; w < n; ++w) std::reverse(p + 4 * w, p + 4 * w + 4);
     }
-    void put(std::vector<std::byte>& to, std::uint64_t& at, const float* values, std::size_t bytes)
+    void append(Stage& s, const std::byte* record, std::size_t n)
     {
-        std::byte record[12];
-        std::memcpy(record, values, bytes);
-        if constexpr (std::endian::native == std::endian::big) swap_words(record, 3);
-        append(to, at, record, bytes);
-    }
-    void append(std::vector<std::byte>& to, std::uint64_t& at, const std::byte* bytes, std::size_t n)
-    {
-        // a record may straddle two pieces: the pieces are cut by bytes, not records
+        if (s.bytes.size() - s.used >= n) { // the usual case
+            std::memcpy(s.bytes.data() + s.used, record, n);
+            s.used += n;
+            if (s.used == s.bytes.size()) write(s);
+            return;
+        }
+        // a record straddling two pieces: the pieces are cut by bytes, not records
         while (n > 0) {
-            const std::size_t room = piece_ - to.size();
-            const std::size_t k = std::min(room, n);
-            to.insert(to.end(), bytes, bytes + k);
-            bytes += k, n -= k;
-            if (to.size() == piece_) write(to, at);
+            const std::size_t k = std::min(s.bytes.size() - s.used, n);
+            std::memcpy(s.bytes.data() + s.used, record, k);
+            s.used += k, record += k, n -= k;
+            if (s.used == s.bytes.size()) write(s);
         }
     }
-    void write(std::vector<std::byte>& bytes, std::uint64_t& at)
+    void write(Stage& s)
     {
-        if (bytes.empty()) return;
-        sink_->write_at(at, bytes);
-        at += bytes.size();
-        bytes.clear();
+        if (s.used == 0) return;
+        sink_->write_at(s.at, std::span<const std::byte>(s.bytes.data(), s.used));
+        s.at += s.used;
+        s.used = 0;
     }
     ByteSink* sink_;
-    std::size_t piece_;
-    std::uint64_t vertex_at_, face_at_;
-    std::vector<std::byte> vertices_, faces_;
+    Stage vertices_, faces_;
 };
 
 /// Own vertices' twins among the vertices of the slab and of the layers on either side: the
@@ -474,7 +486,10 @@ struct RangeRun::Impl {
         PlaneStream stream(reader, windows, bufs);
         bool counting = true; // until a non-finite sample: then only those are counted
         for (Part& p : parts) {
+            Clock::time_point t = Clock::now();
             const GridView<T> g = window_view<T>(stream.next(), p.window, grid);
+            totals.wait_seconds += since(t);
+            t = Clock::now();
             Slab s = p.slabs.front();
             if (counting) {
                 try {
@@ -507,6 +522,7 @@ struct RangeRun::Impl {
                 totals.vertices += s.vertices;
                 totals.triangles += s.triangles;
             }
+            totals.count_seconds += since(t);
             tick(s.b - s.a);
         }
         kept = parts.size() == 1 && !kept_counts.empty();
@@ -530,7 +546,9 @@ struct RangeRun::Impl {
             stream = std::make_unique<PlaneStream>(reader, windows, bufs);
         }
         for (const Part& p : parts) {
+            const Clock::time_point t = Clock::now();
             const GridView<T> g = window_view<T>(stream ? stream->next() : buffers[0].get(), p.window, grid);
+            result.wait_seconds += since(t);
             for (const Slab& s : p.slabs) {
                 std::vector<RangeCounts> counts = kept ? std::move(kept_counts.front()) : count_threads(g, s.a, s.b);
                 emit_slab(g, s, counts, fv, ft, bound, writer, result);
@@ -539,7 +557,9 @@ struct RangeRun::Impl {
             }
             tick(p.slabs.back().b - p.slabs.front().a);
         }
+        const Clock::time_point t = Clock::now();
         writer.flush();
+        result.write_seconds += since(t);
         if (stream) result.planes_read = stream->planes_read();
         kept = false;
         kept_counts.clear();
@@ -550,6 +570,7 @@ struct RangeRun::Impl {
     void emit_slab(const GridView<T>& g, const Slab& s, std::vector<RangeCounts>& counts, std::int64_t fv, std::int64_t ft,
                    double bound, RecordWriter& writer, RangeResult& result) const
     {
+        Clock::time_point started = Clock::now();
         for (RangeCounts& c : counts) c.share_sample_bound(bound);
         const std::vector<RangeOffsets> offsets = scan(counts, fv, ft);
         std::int64_t nv = 0, nt = 0;
@@ -578,10 +599,14 @@ struct RangeRun::Impl {
                                     }
                                 });
         counts.clear();
+        result.emit_seconds += since(started);
+        started = Clock::now();
         writer.vertices(positions.data(), opt.extract.normals ? normals.data() : nullptr, v);
         normals = {};
         writer.faces(triangles.data(), t);
+        result.write_seconds += since(started);
         if (!opt.analyse) return;
+        started = Clock::now();
 
         // The cell layers on either side, emitted here from the buffer's outer planes.
         struct Layer {
@@ -649,6 +674,7 @@ struct RangeRun::Impl {
             if (part.examples.size() < GeometryPart::kExamples) part.examples.push_back({tri_base + pair[0], tri_base + pair[1]});
         }
         result.geometry.add(part);
+        result.analyse_seconds += since(started);
     }
 };
 

@@ -82,6 +82,8 @@ struct RangeTotals {
     Index3 first_non_finite{-1, -1, -1};
     std::int64_t slabs = 0;
     std::int64_t planes_read = 0;    ///< planes read from the file (each once per pass, halos included)
+    double wait_seconds = 0;         ///< waiting for planes (reading that the counting did not hide)
+    double count_seconds = 0;        ///< counting
 };
 
 /// The geometric checks of mesh_geometry() for the triangles and vertices a range owns, each
@@ -103,6 +105,10 @@ struct RangeResult {
     detail::SeamTopology topology;
     GeometryPart geometry;
     std::int64_t planes_read = 0; ///< planes read from the file (none when the count pass kept them)
+    double wait_seconds = 0;      ///< waiting for planes
+    double emit_seconds = 0;      ///< counting again and emitting
+    double write_seconds = 0;     ///< staging records and writing them to the sink
+    double analyse_seconds = 0;   ///< the layers around each slab, its topology and geometry
 };
 
 /// MeshGeometry of a whole mesh from its parts and its topology (welded = topology when no two
