@@ -40,8 +40,6 @@ constexpr std::int64_t kHalo = 2;
 /// vertex and 100 per triangle), with a margin.
 constexpr std::uint64_t kBytesPerVertex = 110, kBytesPerTriangle = 130;
 
-constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
-
 std::uint64_t pieces(std::uint64_t bytes, std::size_t piece) { return (bytes + piece - 1) / piece; }
 
 /// A window of the volume: planes [lo, hi) held in a buffer.

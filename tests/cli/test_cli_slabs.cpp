@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
@@ -176,8 +177,8 @@ TEST(CliSlabs, FailuresAreOneLineNamingTheFileAndLeaveNothing)
     // non-finite samples (away from the surface: cells that need no decision): counted over all slabs
     Volume v = test::make_volume({8, 7, 30}, [](auto i, auto j, auto k) { return static_cast<double>(i + j + k) - 10; });
     double* d = v.samples<double>();
-    d[3 + 8 * (2 + 7 * 14)] = NAN;
-    d[5 + 8 * (6 + 7 * 25)] = -INFINITY;
+    d[3 + 8 * (2 + 7 * 14)] = std::numeric_limits<double>::quiet_NaN();
+    d[5 + 8 * (6 + 7 * 25)] = -std::numeric_limits<double>::infinity();
     io::write_volume(v, dir / "nan.nrrd");
     const Result a = run("extract " + quote((dir / "nan.nrrd").string()) + " -i 0.5");
     const Result b = run("extract " + quote((dir / "nan.nrrd").string()) + " -i 0.5 --memory-limit 600k");
@@ -194,7 +195,7 @@ TEST(CliSlabs, InfoPrintsTheSameSlabBySlab)
 {
     const fs::path dir = test::temp_dir();
     Volume v = noise_f32({31, 17, 40}, 6);
-    v.samples<float>()[100] = NAN;
+    v.samples<float>()[100] = std::numeric_limits<float>::quiet_NaN();
     io::write_volume(v, dir / "f.nrrd");
     Volume s(ScalarType::i16, {30, 20, 25});
     std::mt19937_64 rng(1);

@@ -144,12 +144,13 @@ TEST(VolumePlanes, HeaderAndSizeFaultsAreFoundBeforeAnyPlaneWithReadVolumesMessa
         {"long.nrrd", nrrd_header("uint8", "raw", "little") + samples + "x"},
         {"bad.nrrd", "NRRD0004\ntype: uint8\ndimension: 2\nsizes: 5 4\nencoding: raw\n\n" + samples},
     };
-    for (const auto& [name, bytes] : files) {
-        SCOPED_TRACE(name);
-        test::write_file(dir / name, bytes);
-        const std::string expected = message_of([&] { (void)read_volume(dir / name); });
+    for (const auto& file : files) { // not a structured binding: clang 14 lambdas cannot capture those
+        SCOPED_TRACE(file.first);
+        const auto path = dir / file.first;
+        test::write_file(path, file.second);
+        const std::string expected = message_of([&] { (void)read_volume(path); });
         ASSERT_FALSE(expected.empty());
-        EXPECT_EQ(message_of([&] { (void)describe_volume(dir / name); }), expected);
+        EXPECT_EQ(message_of([&] { (void)describe_volume(path); }), expected);
     }
     EXPECT_NE(message_of([&] { (void)describe_volume(dir / "missing.nrrd"); }).find("missing.nrrd: cannot open"),
               std::string::npos);
@@ -171,13 +172,14 @@ TEST(VolumePlanes, StreamFaultsSurfaceWhenTheirPlaneIsReadWithReadVolumesMessage
         {"trail.mha", "NDims = 3\nDimSize = 5 4 7\nElementType = MET_UCHAR\nCompressedData = True\n"
                       "CompressedDataSize = " + std::to_string(gz.size()) + "\nElementDataFile = LOCAL\n" + gz + "x"},
     };
-    for (const auto& [name, bytes] : files) {
-        SCOPED_TRACE(name);
-        test::write_file(dir / name, bytes);
-        const std::string expected = message_of([&] { (void)read_volume(dir / name); });
+    for (const auto& file : files) {
+        SCOPED_TRACE(file.first);
+        const auto path = dir / file.first;
+        test::write_file(path, file.second);
+        const std::string expected = message_of([&] { (void)read_volume(path); });
         ASSERT_FALSE(expected.empty());
         std::string got = message_of([&] {
-            PlaneReader reader(describe_volume(dir / name));
+            PlaneReader reader(describe_volume(path));
             std::vector<std::byte> plane(static_cast<std::size_t>(reader.layout().plane_bytes()) * 7);
             for (std::int64_t k = 0; k < 7; ++k) reader.read(k, k + 1, plane.data());
         });

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -266,9 +267,9 @@ TEST(Slabs, NonFiniteSamplesAreCountedOverEveryRange)
     double* d = v.samples<double>();
     // far from the surface (every other corner of their cells is above): cells of case 1, which
     // need no decision on the non-finite value
-    d[3 + 6 * (2 + 5 * 10)] = NAN;
-    d[1 + 6 * (4 + 5 * 15)] = INFINITY;
-    d[2 + 6 * (0 + 5 * 16)] = NAN;
+    d[3 + 6 * (2 + 5 * 10)] = std::numeric_limits<double>::quiet_NaN();
+    d[1 + 6 * (4 + 5 * 15)] = std::numeric_limits<double>::infinity();
+    d[2 + 6 * (0 + 5 * 16)] = std::numeric_limits<double>::quiet_NaN();
     const auto path = written(v, "nan.nrrd");
     std::string extract_message;
     try {
