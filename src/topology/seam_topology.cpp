@@ -366,6 +366,7 @@ public:
     template <class T> void array(const std::vector<T>& v)
     {
         value(static_cast<std::uint64_t>(v.size()));
+        if (v.empty()) return;
         const auto* p = reinterpret_cast<const std::byte*>(v.data());
         bytes.insert(bytes.end(), p, p + v.size() * sizeof(T));
     }
@@ -388,7 +389,7 @@ public:
         const auto n = value<std::uint64_t>();
         if (n > (b_.size() - at_) / sizeof(T)) fail();
         std::vector<T> v(static_cast<std::size_t>(n));
-        std::memcpy(v.data(), b_.data() + at_, v.size() * sizeof(T));
+        if (!v.empty()) std::memcpy(v.data(), b_.data() + at_, v.size() * sizeof(T));
         at_ += v.size() * sizeof(T);
         return v;
     }

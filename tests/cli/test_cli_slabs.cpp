@@ -107,14 +107,19 @@ TEST(CliSlabs, ExtractWritesTheSameFileForEveryFormatMethodAndLimit)
     }
     io::write_volume(noise, dir / "noise.raw");
     cases.push_back({dir / "noise.raw", "-0.1", " --dims 23 19 31 --type float"});
-    if (const auto ct = test::shared_volume("CThead_256x256x113_uint16.nrrd")) cases.push_back({*ct, "650", ""}); // gzip
+    if (const auto ct = test::shared_volume("CThead_256x256x113_uint16.nrrd")) {
+        cases.push_back({*ct, "650", " --no-topology"}); // gzip, big-endian; its topology costs minutes under ASan
+    }
     for (const Case& c : cases) {
+        const bool bucky_case = c.input == bucky();
+        // every method and two limits on Bucky; the formats with cmc33 and one limit (time under the sanitizers)
         for (const char* method : {"cmc33", "mc33-lewiner", "mc"}) {
-            if (c.input.filename().string().rfind("CThead", 0) == 0 && std::string(method) != "cmc33") continue; // time
+            if (!bucky_case && std::string(method) != "cmc33") continue;
             const std::string common = quote(c.input.string()) + c.raw + " -i " + c.iso + " --method " + method + " --normals --json";
             const Result whole = run("extract " + common + " -o " + quote((dir / "whole.ply").string()));
             ASSERT_EQ(whole.code, 0) << whole.err;
             for (const char* limit : {"6M", "64M"}) {
+                if (!bucky_case && std::string(limit) != "6M") continue;
                 const std::string what = c.input.filename().string() + " " + method + " " + limit;
                 const Result slabs = run("extract " + common + " -o " + quote((dir / "slabs.ply").string()) +
                                          " --memory-limit " + limit + " --threads 2");
