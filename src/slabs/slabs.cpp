@@ -37,8 +37,9 @@ constexpr std::int64_t kHalo = 2;
 /// Bytes per vertex and per triangle of a slab while it is emitted, written and analysed: the
 /// mesh arrays (12 per vertex for positions, 12 more for normals; 12 per triangle), the copy and
 /// working memory of mesh_geometry() and SeamTopology (measured on extracted meshes: about 75 per
-/// vertex and 100 per triangle), with a margin.
+/// vertex and 100 per triangle), with a margin; without the analysis, the arrays and a margin.
 constexpr std::uint64_t kBytesPerVertex = 110, kBytesPerTriangle = 130;
+constexpr std::uint64_t kBytesPerVertexBare = 18, kBytesPerTriangleBare = 18;
 
 std::uint64_t pieces(std::uint64_t bytes, std::size_t piece) { return (bytes + piece - 1) / piece; }
 
@@ -447,8 +448,9 @@ struct RangeRun::Impl {
 
     std::uint64_t estimate(std::int64_t vertices, std::int64_t triangles) const
     {
-        const std::uint64_t v = kBytesPerVertex + (opt.extract.normals ? 12 : 0);
-        return static_cast<std::uint64_t>(vertices) * v + static_cast<std::uint64_t>(triangles) * kBytesPerTriangle;
+        const std::uint64_t v = (opt.analyse ? kBytesPerVertex : kBytesPerVertexBare) + (opt.extract.normals ? 18 : 0);
+        const std::uint64_t t = opt.analyse ? kBytesPerTriangle : kBytesPerTriangleBare;
+        return static_cast<std::uint64_t>(vertices) * v + static_cast<std::uint64_t>(triangles) * t;
     }
 
     /// Cuts slab [a, b) until each piece's mesh fits the budget; appends the pieces to `out`.
