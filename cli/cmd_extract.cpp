@@ -14,26 +14,11 @@
 #include "cmc33/topology.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "extract_report.hpp"
 
 namespace cmc33::cli {
 
 namespace {
-
-struct ExtractArgs {
-    std::string input;
-    double iso = 0;
-    std::string output;
-    std::string method = "cmc33";
-    bool normals = false;
-    int threads = 0;
-    bool json = false;
-    bool ascii = false;
-    int repeat = 1;
-    bool no_topology = false;
-    bool progress = false;
-    bool quiet = false;
-    RawVolumeOptions raw;
-};
 
 double median(std::vector<double> values)
 {
@@ -89,53 +74,20 @@ void run_extract(const ExtractArgs& args)
                    [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii}); });
     }
 
-    const int threads = args.threads > 0 ? args.threads
-                                         : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    if (args.json) {
-        // Subcase "0" (no crossing) is left out: extract counts the cells the surface crosses.
-        Json subcases = Json::object();
-        for (int s = 1; s < kSubcaseCount; ++s) {
-            subcases[std::string(subcase_name(s))] = stats.cells_per_subcase[static_cast<std::size_t>(s)];
-        }
-        Json out{{"input", volume_json(args.input, volume)},
-                 {"iso", args.iso},
-                 {"method", std::string(method_name(options.method))},
-                 {"normals", args.normals},
-                 {"vertices", mesh.vertex_count()},
-                 {"triangles", mesh.triangle_count()},
-                 {"seconds", seconds},
-                 {"runs_seconds", runs},
-                 {"threads", threads},
-                 {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
-                 {"topology", !args.no_topology ? topology_json(topology) : Json(nullptr)},
-                 {"geometry", !args.no_topology ? geometry_json(geometry) : Json(nullptr)},
-                 {"subcases", subcases}};
-        print_json(out);
-        return;
-    }
-    std::string line = args.input + ": " + dims_text(volume.dims()) + " " + std::string(type_name(volume.type())) +
-                       ", iso " + num(args.iso) + ", " + std::string(method_name(options.method)) + ": " +
-                       std::to_string(mesh.vertex_count()) + " vertices, " +
-                       std::to_string(mesh.triangle_count()) + " triangles in " + sig(seconds, 3) + " s";
-    if (args.repeat > 1) line += " (median of " + std::to_string(args.repeat) + ")";
-    if (!args.no_topology) {
-        line += "; euler " + std::to_string(topology.euler) + ", components " +
-                std::to_string(topology.components) + ", boundary edges " +
-                std::to_string(topology.boundary_edges) + ", non-manifold edges " +
-                std::to_string(topology.nonmanifold_edges);
-    }
-    if (!args.no_topology && topology.nonmanifold_vertices != 0) {
-        line += ", non-manifold vertices " + std::to_string(topology.nonmanifold_vertices);
-    }
-    if (!args.no_topology) {
-        line += geometry.embedded() ? ", embedded"
-                                    : ", NOT embedded (" + std::to_string(geometry.coincident_vertices) +
-                                          " coincident vertices, " + std::to_string(geometry.zero_area_triangles) +
-                                          " zero-area triangles, " + std::to_string(geometry.intersecting_pairs) +
-                                          " intersecting triangle pairs)";
-    }
-    if (!args.output.empty()) line += " (" + args.output + ")";
-    std::cout << line << '\n';
+    ExtractReport report;
+    report.volume = volume_json(args.input, volume);
+    report.dims = volume.dims();
+    report.type = volume.type();
+    report.method = options.method;
+    report.vertices = static_cast<std::int64_t>(mesh.vertex_count());
+    report.triangles = static_cast<std::int64_t>(mesh.triangle_count());
+    report.seconds = seconds;
+    report.runs_seconds = runs;
+    report.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    report.topology = topology;
+    report.geometry = geometry;
+    report.stats = stats;
+    print_extract_report(args, report);
 }
 
 } // namespace
@@ -171,6 +123,20 @@ void add_extract(CLI::App& app)
                                    "Progress lines on stderr even when it is not a terminal");
     cmd->add_flag("--quiet", args->quiet, "No progress line (shown on a terminal when extraction takes over a second)")
         ->excludes(progress);
+    cmd->add_option("--memory-limit", args->memory_limit,
+                    "Read the volume and write the mesh slab by slab within SIZE bytes (256M, 2G): for "
+                    "volumes and meshes larger than memory; binary .ply only, same bytes")
+        ->type_name("SIZE")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    (void)slabs_size(text);
+                    return {};
+                } catch (const Error& e) {
+                    return e.what();
+                }
+            },
+            "SIZE", "size"));
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT, extracts the triangle mesh of the isosurface at ISO with Marching Cubes 33\n"
@@ -179,12 +145,22 @@ void add_extract(CLI::App& app)
         "reading or writing), and the mesh's topology (Euler characteristic, components, boundary\n"
         "and non-manifold edges). With -o the mesh is written in the format of OUT's extension.\n"
         "--json prints the same and more (per-subcase cell counts, Betti numbers) as one object.\n"
+        "--memory-limit streams: the volume is read twice, slab by slab (count, then emit), and the\n"
+        "mesh written as it is made; the file is byte for byte the one written without it, and the\n"
+        "time reported is then the whole run's (reading and writing included).\n"
         "\n"
         "Examples:\n"
         "  cmc33 extract aneurism.nrrd --iso 80 -o vessels.ply\n"
         "  cmc33 extract scan.raw --dims 256 256 128 --type uint16 --endian big -i 600 --json\n"
-        "  cmc33 extract bonsai.nrrd -i 40 --method mc --repeat 5 --threads 1");
-    cmd->callback([args] { run_extract(*args); });
+        "  cmc33 extract bonsai.nrrd -i 40 --method mc --repeat 5 --threads 1\n"
+        "  cmc33 extract scan_4096.nrrd -i 900 -o bone.ply --memory-limit 4G");
+    cmd->callback([args] {
+        if (args->memory_limit.empty()) {
+            run_extract(*args);
+        } else {
+            run_extract_slabs(*args);
+        }
+    });
 }
 
 } // namespace cmc33::cli

@@ -5,11 +5,18 @@
 #include <cmath>
 #include <cstdint>
 #include <iostream>
+#include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <tuple>
+#include <type_traits>
 #include <vector>
 
+#include "cmc33/error.hpp"
 #include "cmc33/volume.hpp"
+#include "plane_reader.hpp"
+#include "slabs.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 
@@ -23,6 +30,7 @@ constexpr int kFineBins = 4096; // the one quantiles and Otsu's threshold are re
 struct InfoArgs {
     std::string input;
     bool json = false;
+    std::string memory_limit; ///< empty: the volume in memory
     RawVolumeOptions raw;
 };
 
@@ -51,17 +59,122 @@ struct Histogram {
     }
 };
 
-template <class T> void fill(const GridView<T>& grid, std::int64_t count, Histogram& h)
+/// `n` samples of value v (finite) into the histogram.
+void add(Histogram& h, double v, std::int64_t n)
+{
+    h.finite += n;
+    const double u = h.fraction(v);
+    h.bins[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(u * kBins)))] += n;
+    const auto f = static_cast<std::size_t>(std::min(kFineBins - 1, static_cast<int>(u * kFineBins)));
+    if (h.fine[f] == 0 || v < h.fine_min[f]) h.fine_min[f] = v;
+    h.fine[f] += n;
+}
+
+template <class T> void fill(const T* samples, std::int64_t count, Histogram& h)
 {
     for (std::int64_t i = 0; i < count; ++i) {
-        const double v = static_cast<double>(grid.data[i]);
-        if (!std::isfinite(v)) continue;
-        ++h.finite;
-        const double u = h.fraction(v);
-        h.bins[static_cast<std::size_t>(std::min(kBins - 1, static_cast<int>(u * kBins)))]++;
-        const auto f = static_cast<std::size_t>(std::min(kFineBins - 1, static_cast<int>(u * kFineBins)));
-        if (h.fine[f]++ == 0 || v < h.fine_min[f]) h.fine_min[f] = v;
+        const double v = static_cast<double>(samples[i]);
+        if (std::isfinite(v)) add(h, v, 1);
     }
+}
+
+/// What info shows of a volume, from the volume in memory or read slab by slab.
+struct Summary {
+    Json volume;           ///< volume_json()
+    Index3 dims{};
+    ScalarType type = ScalarType::u8;
+    Vec3 spacing{}, origin{};
+    Mat3 direction = kIdentity3;
+    std::string space;
+    std::int64_t samples = 0;
+    std::uint64_t bytes = 0;
+    double lo = 0, hi = 0; ///< value_range()
+    NonFinite bad;
+    Histogram h;
+};
+
+Summary summarize(const std::string& path, const Volume& volume)
+{
+    Summary s;
+    s.volume = volume_json(path, volume);
+    s.dims = volume.dims();
+    s.type = volume.type();
+    s.spacing = volume.spacing(), s.origin = volume.origin(), s.direction = volume.direction(), s.space = volume.space();
+    s.samples = volume.sample_count();
+    s.bytes = volume.byte_size();
+    std::tie(s.lo, s.hi) = value_range(volume);
+    s.bad = find_non_finite(volume);
+    s.h.lo = s.lo, s.h.hi = s.hi;
+    volume.visit([&](const auto& grid) { fill(grid.data, volume.sample_count(), s.h); });
+    return s;
+}
+
+/// summarize() of a volume read a few planes at a time within `limit` bytes: samples of 8 and
+/// 16 bits in one pass (a count per value, from which the range and the histogram follow), wider
+/// ones in two (the range, then the histogram, whose bins depend on it).
+Summary summarize_slabs(const std::string& path, const std::optional<io::RawOptions>& raw, std::uint64_t limit)
+{
+    const io::detail::VolumeLayout layout =
+        named_step(path, "reading the volume's header", [&] { return io::detail::describe_volume(path, raw); });
+    const io::detail::Grid& g = layout.grid;
+    Summary s;
+    s.volume = volume_json(path, g.dims, g.type, g.spacing, g.origin, g.direction, g.space);
+    s.dims = g.dims;
+    s.type = g.type;
+    s.spacing = g.spacing, s.origin = g.origin, s.direction = g.direction, s.space = g.space;
+    s.samples = g.dims[0] * g.dims[1] * g.dims[2];
+    s.lo = std::numeric_limits<double>::infinity(), s.hi = -s.lo; // as value_range(): none finite yet
+    s.bytes = static_cast<std::uint64_t>(s.samples) * type_size(g.type);
+    const std::uint64_t plane = layout.plane_bytes();
+    const std::int64_t nz = g.dims[2];
+    const std::int64_t planes = std::clamp<std::int64_t>(static_cast<std::int64_t>(limit / 2 / std::max<std::uint64_t>(plane, 1)), 1, nz);
+    std::vector<std::byte> buffer(static_cast<std::size_t>(static_cast<std::uint64_t>(planes) * plane));
+    io::detail::PlaneReader reader(layout);
+    const auto each_slab = [&](const auto& visit) {
+        for (std::int64_t k = 0; k < nz; k += planes) {
+            const std::int64_t k1 = std::min(nz, k + planes);
+            named_step(path, "reading the volume", [&] { reader.read(k, k1, buffer.data()); });
+            visit(k, (k1 - k) * g.dims[0] * g.dims[1]);
+        }
+    };
+    dispatch_scalar_type(g.type, [&](auto tag) {
+        using T = decltype(tag);
+        const auto* data = reinterpret_cast<const T*>(buffer.data());
+        if constexpr (sizeof(T) <= 2 && std::is_integral_v<T>) {
+            std::vector<std::int64_t> counts(std::size_t{1} << (8 * sizeof(T)), 0);
+            each_slab([&](std::int64_t, std::int64_t n) {
+                for (std::int64_t i = 0; i < n; ++i) ++counts[static_cast<std::make_unsigned_t<T>>(data[i])];
+            });
+            for (std::size_t u = 0; u < counts.size(); ++u) {
+                if (counts[u] == 0) continue;
+                const double v = static_cast<double>(static_cast<T>(static_cast<std::make_unsigned_t<T>>(u)));
+                s.lo = std::min(s.lo, v);
+                s.hi = std::max(s.hi, v);
+            }
+            s.h.lo = s.lo, s.h.hi = s.hi;
+            for (std::size_t u = 0; u < counts.size(); ++u) {
+                if (counts[u] > 0) add(s.h, static_cast<double>(static_cast<T>(static_cast<std::make_unsigned_t<T>>(u))), counts[u]);
+            }
+        } else {
+            each_slab([&](std::int64_t k, std::int64_t n) {
+                for (std::int64_t i = 0; i < n; ++i) {
+                    const double v = static_cast<double>(data[i]);
+                    if (!std::isfinite(v)) {
+                        if (s.bad.count++ == 0) {
+                            const std::int64_t at = k * g.dims[0] * g.dims[1] + i;
+                            s.bad.first = {at % g.dims[0], at / g.dims[0] % g.dims[1], at / (g.dims[0] * g.dims[1])};
+                        }
+                        continue;
+                    }
+                    s.lo = v < s.lo ? v : s.lo; // value_range()'s comparisons: the first of -0 and +0 stays
+                    s.hi = v > s.hi ? v : s.hi;
+                }
+            });
+            s.h.lo = s.lo, s.h.hi = s.hi;
+            each_slab([&](std::int64_t, std::int64_t n) { fill(data, n, s.h); });
+        }
+    });
+    return s;
 }
 
 /// The q-quantile of the finite samples, read from the fine histogram: the smallest sample of the
@@ -159,10 +272,9 @@ std::string bar(std::int64_t n, std::int64_t largest)
 
 /// The frame beyond spacing and origin: the named space, and the direction of each axis when
 /// they are not x, y, z themselves (docs/conventions.md).
-void print_frame(const Volume& volume)
+void print_frame(const std::string& space, const Mat3& d)
 {
-    if (!volume.space().empty()) std::cout << "space " << volume.space() << '\n';
-    const Mat3& d = volume.direction();
+    if (!space.empty()) std::cout << "space " << space << '\n';
     if (d == kIdentity3) return;
     std::cout << "directions (world direction of +i, +j, +k):";
     for (std::size_t a = 0; a < 3; ++a) std::cout << " " << "ijk"[a] << " " << vec_text({d[0][a], d[1][a], d[2][a]});
@@ -171,19 +283,20 @@ void print_frame(const Volume& volume)
 
 void run_info(const InfoArgs& args)
 {
-    const Volume volume = load_volume(args.input, args.raw);
-    const auto [lo, hi] = value_range(volume);
-    const NonFinite bad = find_non_finite(volume);
-    Histogram h;
-    h.lo = lo, h.hi = hi;
-    volume.visit([&](const auto& grid) { fill(grid, volume.sample_count(), h); });
-    const std::vector<Candidate> cand = candidates(h, volume.type());
+    const Summary summary = args.memory_limit.empty()
+                                ? summarize(args.input, load_volume(args.input, args.raw))
+                                : summarize_slabs(args.input, raw_volume_options(args.input, args.raw),
+                                                  slabs::parse_size(args.memory_limit));
+    const double lo = summary.lo, hi = summary.hi;
+    const NonFinite& bad = summary.bad;
+    const Histogram& h = summary.h;
+    const std::vector<Candidate> cand = candidates(h, summary.type);
     const std::array<double, 5> qs{0.01, 0.25, 0.5, 0.75, 0.99};
     const bool has_values = h.finite > 0;
 
     if (args.json) {
-        Json out = volume_json(args.input, volume);
-        out["samples"] = volume.sample_count();
+        Json out = summary.volume;
+        out["samples"] = summary.samples;
         out["min"] = has_values ? json_number(lo) : Json(nullptr);
         out["max"] = has_values ? json_number(hi) : Json(nullptr);
         out["non_finite"] = {{"count", bad.count},
@@ -204,10 +317,10 @@ void run_info(const InfoArgs& args)
         print_json(out);
         return;
     }
-    std::cout << args.input << ": " << dims_text(volume.dims()) << " " << type_name(volume.type()) << " ("
-              << volume.sample_count() << " samples, " << volume.byte_size() << " bytes)\n";
-    std::cout << "spacing " << vec_text(volume.spacing()) << ", origin " << vec_text(volume.origin()) << '\n';
-    print_frame(volume);
+    std::cout << args.input << ": " << dims_text(summary.dims) << " " << type_name(summary.type) << " ("
+              << summary.samples << " samples, " << summary.bytes << " bytes)\n";
+    std::cout << "spacing " << vec_text(summary.spacing) << ", origin " << vec_text(summary.origin) << '\n';
+    print_frame(summary.space, summary.direction);
     if (!has_values) {
         std::cout << "no finite samples\n";
     } else {
@@ -250,6 +363,19 @@ void add_info(CLI::App& app)
     cmd->add_option("INPUT", args->input, "Volume: .nrrd .nhdr .mhd .mha .vtk, or headerless raw with --dims/--type")
         ->required();
     cmd->add_flag("--json", args->json, "Print one JSON object");
+    cmd->add_option("--memory-limit", args->memory_limit,
+                    "Read the volume a few planes at a time within SIZE bytes (256M, 2G); the same output")
+        ->type_name("SIZE")
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                try {
+                    (void)slabs::parse_size(text);
+                    return {};
+                } catch (const Error& e) {
+                    return e.what();
+                }
+            },
+            "SIZE", "size"));
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT and prints its dimensions, sample type, spacing and origin (and the axis\n"
@@ -258,10 +384,13 @@ void add_info(CLI::App& app)
         "and some quantiles, then a hint with isovalues worth trying: Otsu's threshold (the value\n"
         "that best splits the samples in two classes, e.g. object and air) and the midpoints\n"
         "between the largest histogram modes. --json prints all of it as one object.\n"
+        "--memory-limit reads the volume slab by slab (8- and 16-bit samples in one pass, wider ones\n"
+        "in two: the range, then the histogram), for volumes larger than memory.\n"
         "\n"
         "Examples:\n"
         "  cmc33 info aneurism.nrrd\n"
-        "  cmc33 info scan.raw --dims 512 512 300 --type int16 --json");
+        "  cmc33 info scan.raw --dims 512 512 300 --type int16 --json\n"
+        "  cmc33 info scan_4096.nrrd --memory-limit 1G");
     cmd->callback([args] { run_info(*args); });
 }
 

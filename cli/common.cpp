@@ -99,12 +99,18 @@ void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw)
 
 Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
 {
+    const std::optional<io::RawOptions> options = raw_volume_options(path, raw);
+    return named_step(path, "reading the volume", [&] { return io::read_volume(path, options); });
+}
+
+std::optional<io::RawOptions> raw_volume_options(const std::string& path, const RawVolumeOptions& raw)
+{
     if (io::has_volume_header(path)) {
         if (raw.any_given()) {
             throw UsageError("--dims/--type are for headerless raw files; " + path +
                              " has a header that gives its dimensions and type");
         }
-        return named_step(path, "reading the volume", [&] { return io::read_volume(path); });
+        return std::nullopt;
     }
     const bool has_dims = !raw.dims.empty(), has_type = !raw.type.empty();
     if (!has_dims || !has_type) {
@@ -126,7 +132,7 @@ Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
     if (!raw.spacing.empty()) options.spacing = {raw.spacing[0], raw.spacing[1], raw.spacing[2]};
     options.endian = raw.endian == "big" ? io::Endian::big : io::Endian::little;
     options.header_bytes = raw.header_bytes;
-    return named_step(path, "reading the volume", [&] { return io::read_volume(path, options); });
+    return options;
 }
 
 CLI::Validator method_validator()
@@ -254,20 +260,23 @@ Json json_number(double value)
 
 Json volume_json(const std::string& path, const Volume& volume)
 {
-    const Index3& d = volume.dims();
-    const Vec3& s = volume.spacing();
-    const Vec3& o = volume.origin();
-    const Mat3& m = volume.direction();
+    return volume_json(path, volume.dims(), volume.type(), volume.spacing(), volume.origin(), volume.direction(),
+                       volume.space());
+}
+
+Json volume_json(const std::string& path, const Index3& d, ScalarType type, const Vec3& s, const Vec3& o, const Mat3& m,
+                 const std::string& space)
+{
     Json direction = Json::array(); // row by row: column a is the world direction of axis a
     for (const Vec3& row : m) direction.push_back({json_number(row[0]), json_number(row[1]), json_number(row[2])});
     return Json{{"file", path},
                 {"dims", {d[0], d[1], d[2]}},
-                {"type", std::string(type_name(volume.type()))},
+                {"type", std::string(type_name(type))},
                 {"spacing", {json_number(s[0]), json_number(s[1]), json_number(s[2])}},
                 {"origin", {json_number(o[0]), json_number(o[1]), json_number(o[2])}},
                 {"direction", direction},
                 {"mirrored", determinant(m) < 0},
-                {"space", volume.space().empty() ? Json(nullptr) : Json(volume.space())}};
+                {"space", space.empty() ? Json(nullptr) : Json(space)}};
 }
 
 Json topology_json(const MeshTopology& t)

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -13,6 +14,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
@@ -47,6 +49,10 @@ void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw);
 /// Reads a volume. Files with a known header take no raw options (UsageError if some are given);
 /// other files need --dims and --type (UsageError if missing). @throws Error from the readers.
 Volume load_volume(const std::string& path, const RawVolumeOptions& raw);
+
+/// What load_volume() reads `path` with: nullopt for a file with a header, the raw options
+/// otherwise (UsageError and Error as load_volume()).
+std::optional<io::RawOptions> raw_volume_options(const std::string& path, const RawVolumeOptions& raw);
 
 /// A CLI11 validator accepting the names cmc33::parse_method accepts.
 CLI::Validator method_validator();
@@ -96,6 +102,9 @@ std::string vec_text(const Vec3& v);
 Json json_number(double value);
 /// {"file", "dims", "type", "spacing", "origin"}.
 Json volume_json(const std::string& path, const Volume& volume);
+/// The same from a header's values (a volume read slab by slab has no Volume).
+Json volume_json(const std::string& path, const Index3& dims, ScalarType type, const Vec3& spacing, const Vec3& origin,
+                 const Mat3& direction, const std::string& space);
 /// {"euler", "betti", "components", "closed_components", "boundary_edges", "boundary_loops",
 ///  "nonmanifold_edges", "nonmanifold_vertices", "degenerate_triangles", "closed", "oriented"}.
 Json topology_json(const MeshTopology& topology);

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz] [--web]
+# Idempotent and quiet when everything is present.
+# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--web]
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --mpi    also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
 #   --web    also emscripten, node and npm, and chromium for the page's browser tests (web/)
 set -euo pipefail
 
@@ -14,6 +16,7 @@ for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
+    --mpi) packages+=(libopenmpi-dev openmpi-bin) ;;
     --web)
         # node-acorn: emscripten's optimizer requires it. node and npm only where there are none
         # (a node from elsewhere, with its own npm, is kept).
@@ -21,7 +24,7 @@ for flag in "$@"; do
         command -v node >/dev/null || packages+=(nodejs)
         command -v npm >/dev/null || packages+=(npm)
         ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz or --web" >&2; exit 2 ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi or --web" >&2; exit 2 ;;
     esac
 done
 

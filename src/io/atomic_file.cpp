@@ -1,15 +1,18 @@
 #include "atomic_file.hpp"
 
 #include <atomic>
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <csignal>
+#include <cstring>
 #include <fstream>
 #include <mutex>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -127,7 +130,7 @@ int remove_temporaries() noexcept
     return removed;
 }
 
-void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write)
+std::filesystem::path temporary_beside(const std::filesystem::path& path)
 {
     static std::atomic<unsigned> counter{0};
     const std::filesystem::path dir = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
@@ -141,8 +144,16 @@ void write_atomically(const std::filesystem::path& path, const std::function<voi
     std::string temp_name = ".";  // built piecewise: g++ 12 warns falsely on "." + string (-Wrestrict)
     temp_name += path.filename().string();
     temp_name += ".tmp" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    return dir / temp_name;
+}
+
+void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write)
+{
+    const std::filesystem::path temp_path = temporary_beside(path);
+    const std::filesystem::path dir = temp_path.parent_path();
+    std::error_code ec;
     std::ofstream out;
-    Temporary temp(dir / temp_name, [&] { out.open(dir / temp_name, std::ios::binary | std::ios::trunc); });
+    Temporary temp(temp_path, [&] { out.open(temp_path, std::ios::binary | std::ios::trunc); });
     if (!out) throw Error(Status::io_error, path.string() + ": cannot create a file in " + dir.string());
     write(out);
     out.flush();
@@ -152,6 +163,51 @@ void write_atomically(const std::filesystem::path& path, const std::function<voi
     temp.commit([&] {
         std::filesystem::rename(temp.path(), path, ec);
         if (ec) throw Error(Status::io_error, path.string() + ": cannot rename the temporary file: " + ec.message());
+    });
+}
+
+PositionalFile::PositionalFile(const std::filesystem::path& path) : path_(path)
+{
+    const std::filesystem::path temp_path = temporary_beside(path);
+    int error = 0;
+    temp_ = std::make_unique<Temporary>(temp_path, [&] {
+        fd_ = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        error = errno;
+    });
+    if (fd_ < 0) {
+        throw Error(Status::io_error, path.string() + ": cannot create a file in " + temp_path.parent_path().string() +
+                                          " (" + std::strerror(error) + ")");
+    }
+}
+
+PositionalFile::~PositionalFile()
+{
+    if (fd_ >= 0) ::close(fd_);
+    temp_.reset(); // removes the temporary unless committed
+}
+
+void PositionalFile::write_at(std::uint64_t offset, const void* data, std::size_t count)
+{
+    const auto* p = static_cast<const unsigned char*>(data);
+    while (count > 0) {
+        const ::ssize_t n = ::pwrite(fd_, p, std::min<std::size_t>(count, std::size_t{1} << 30), static_cast<::off_t>(offset));
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) {
+            throw Error(Status::io_error, path_.string() + ": writing failed at byte " + std::to_string(offset) + " (" +
+                                              (n < 0 ? std::strerror(errno) : "nothing written") + "; disk full?)");
+        }
+        p += n, offset += static_cast<std::uint64_t>(n), count -= static_cast<std::size_t>(n);
+    }
+}
+
+void PositionalFile::commit()
+{
+    const int fd = std::exchange(fd_, -1);
+    if (::close(fd) != 0) throw Error(Status::io_error, path_.string() + ": closing failed (disk full?)");
+    temp_->commit([&] {
+        std::error_code ec;
+        std::filesystem::rename(temp_->path(), path_, ec);
+        if (ec) throw Error(Status::io_error, path_.string() + ": cannot rename the temporary file: " + ec.message());
     });
 }
 

@@ -18,6 +18,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <ostream>
 #include <string>
 
@@ -30,6 +31,31 @@ namespace cmc33::io::detail {
 /// (or write's own exception) propagates; `path` is left as it was.
 /// The temporary is `.NAME.tmpPID-N` in the target's folder (NAME the target's file name).
 CMC33_IO_EXPORT void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
+
+/// The name of a new temporary beside `path`: `.NAME.tmpPID-N` in its folder (checked to be a
+/// folder: Error{io_error} otherwise, or when `path` is a directory).
+CMC33_IO_EXPORT std::filesystem::path temporary_beside(const std::filesystem::path& path);
+
+/// A file written at offsets, in any order (pwrite): a temporary beside `path` (registered, so a
+/// signal removes it), renamed to `path` by commit(). Destroyed before commit(), it is removed
+/// and `path` is left as it was. For writers that know where every byte goes (out-of-core slabs).
+class CMC33_IO_EXPORT PositionalFile {
+public:
+    /// @throws Error{io_error} if the temporary cannot be created
+    explicit PositionalFile(const std::filesystem::path& path);
+    ~PositionalFile();
+    PositionalFile(const PositionalFile&) = delete;
+    PositionalFile& operator=(const PositionalFile&) = delete;
+    /// @throws Error{io_error} naming `path` (disk full, ...)
+    void write_at(std::uint64_t offset, const void* data, std::size_t count);
+    /// Closes the temporary and renames it to `path`. @throws Error{io_error}
+    void commit();
+
+private:
+    std::filesystem::path path_;
+    int fd_ = -1;
+    std::unique_ptr<class Temporary> temp_;
+};
 
 /// Lower-case extension with the dot (".ply"); "" if none.
 CMC33_IO_EXPORT std::string lower_extension(const std::filesystem::path& path);

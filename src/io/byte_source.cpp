@@ -217,95 +217,159 @@ void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const
     }
 }
 
-namespace {
+// ---- InflateStream --------------------------------------------------------------------------
 
 #if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
-/// Pulls bytes out of the stream(s) in `in`, one caller buffer at a time.
-class Inflater {
-public:
-    Inflater(std::string_view in, const std::string& label) : in_(in), label_(label)
-    {
-        // 15 + 32: a 32 KiB window, and a zlib or gzip header recognised automatically.
-        const int status = inflateInit2(&z_, 15 + 32);
-        if (status != Z_OK) {
-            throw Error(status == Z_MEM_ERROR ? Status::too_large : Status::internal,
-                        label_ + ": cannot start zlib inflate (" + std::to_string(status) + ")");
+InflateStream::InflateStream(const ByteInput& input, std::uint64_t offset, std::uint64_t size, std::string label)
+    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_(new unsigned char[kBlock]),
+      z_(new z_stream_s{})
+{
+    // 15 + 32: a 32 KiB window, and a zlib or gzip header recognised automatically.
+    const int status = inflateInit2(z_.get(), 15 + 32);
+    if (status != Z_OK) {
+        throw Error(status == Z_MEM_ERROR ? Status::too_large : Status::internal,
+                    label_ + ": cannot start zlib inflate (" + std::to_string(status) + ")");
+    }
+}
+
+InflateStream::~InflateStream() { inflateEnd(z_.get()); }
+
+std::uint64_t InflateStream::consumed() const noexcept { return fed_ - z_->avail_in; }
+
+std::size_t InflateStream::produce(unsigned char* out, std::size_t count)
+{
+    std::size_t done = 0;
+    while (done < count) {
+        if (ended_) {
+            // A gzip file may hold several members one after the other: continue into the next.
+            const std::uint64_t at = consumed();
+            unsigned char magic[2] = {0, 0};
+            if (size_ - at < 2) break;
+            in_.read(offset_ + at, magic, 2);
+            if (magic[0] != 0x1f || magic[1] != 0x8b) break;
+            inflateReset(z_.get());
+            ended_ = false;
+        }
+        if (z_->avail_in == 0) {
+            if (fed_ == size_) break;
+            const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - fed_, kBlock));
+            in_.read(offset_ + fed_, block_.get(), n);
+            z_->next_in = block_.get();
+            z_->avail_in = static_cast<uInt>(n);
+            fed_ += n;
+        }
+        const std::size_t room = std::min<std::size_t>(count - done, kMaxOut);
+        z_->next_out = out + done;
+        z_->avail_out = static_cast<uInt>(room);
+        const int status = inflate(z_.get(), Z_NO_FLUSH);
+        done += room - z_->avail_out;
+        if (status == Z_STREAM_END) {
+            ended_ = true;
+        } else if (status == Z_BUF_ERROR) {
+            // No progress possible: the input is used up (a full output is handled by the loop).
+            if (z_->avail_in == 0 && fed_ < size_) continue;
+            break;
+        } else if (status == Z_DATA_ERROR) {
+            throw Error(Status::bad_format,
+                        label_ + ": corrupt compressed data near byte " + std::to_string(consumed()) + " of the " +
+                            std::to_string(size_) + "-byte stream (zlib: " + (z_->msg ? z_->msg : "invalid data") + ")");
+        } else if (status == Z_NEED_DICT) {
+            throw Error(Status::unsupported_format, label_ + ": the compressed stream needs a preset dictionary");
+        } else if (status == Z_MEM_ERROR) {
+            throw Error(Status::too_large, label_ + ": zlib ran out of memory while inflating");
+        } else if (status != Z_OK) {
+            throw Error(Status::internal, label_ + ": zlib inflate returned " + std::to_string(status));
         }
     }
-    ~Inflater() { inflateEnd(&z_); }
-    Inflater(const Inflater&) = delete;
-    Inflater& operator=(const Inflater&) = delete;
+    produced_ += done;
+    return done;
+}
 
-    /// Writes up to `count` bytes to `out`; fewer only when the input ended (then `ended()` says
-    /// whether the stream was complete). Returns how many were written.
-    std::size_t produce(unsigned char* out, std::size_t count)
-    {
-        std::size_t done = 0;
-        while (done < count) {
-            if (ended_) {
-                // A gzip file may hold several members one after the other: continue into the next.
-                const std::string_view rest = in_.substr(consumed());
-                if (rest.size() < 2 || static_cast<unsigned char>(rest[0]) != 0x1f ||
-                    static_cast<unsigned char>(rest[1]) != 0x8b) {
-                    break;
-                }
-                inflateReset(&z_);
-                ended_ = false;
-            }
-            if (z_.avail_in == 0) {
-                if (fed_ == in_.size()) break;
-                const std::size_t n = std::min<std::size_t>(in_.size() - fed_, kMaxChunk);
-                z_.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(in_.data() + fed_));
-                z_.avail_in = static_cast<uInt>(n);
-                fed_ += n;
-            }
-            const std::size_t room = std::min<std::size_t>(count - done, kMaxChunk);
-            z_.next_out = out + done;
-            z_.avail_out = static_cast<uInt>(room);
-            const int status = inflate(&z_, Z_NO_FLUSH);
-            done += room - z_.avail_out;
-            if (status == Z_STREAM_END) {
-                ended_ = true;
-            } else if (status == Z_BUF_ERROR) {
-                // No progress possible: the input is used up (a full output is handled by the
-                // loop).
-                if (z_.avail_in == 0 && fed_ < in_.size()) continue;
-                break;
-            } else if (status == Z_DATA_ERROR) {
-                throw Error(Status::bad_format,
-                            label_ + ": corrupt compressed data near byte " +
-                                std::to_string(consumed()) + " of the " +
-                                std::to_string(in_.size()) +
-                                "-byte stream (zlib: " + (z_.msg ? z_.msg : "invalid data") + ")");
-            } else if (status == Z_NEED_DICT) {
-                throw Error(Status::unsupported_format,
-                            label_ + ": the compressed stream needs a preset dictionary");
-            } else if (status == Z_MEM_ERROR) {
-                throw Error(Status::too_large, label_ + ": zlib ran out of memory while inflating");
-            } else if (status != Z_OK) {
-                throw Error(Status::internal,
-                            label_ + ": zlib inflate returned " + std::to_string(status));
-            }
-        }
-        return done;
-    }
-
-    bool ended() const noexcept { return ended_; }
-    std::size_t consumed() const noexcept { return fed_ - z_.avail_in; }
-
-private:
-    static constexpr std::size_t kMaxChunk = std::size_t{1} << 30; // zlib counts in 32-bit uInt
-    z_stream z_{};
-    std::string_view in_;
-    const std::string& label_;
-    std::size_t fed_ = 0;
-    bool ended_ = false;
-};
 #else
-using Inflater = PortableInflater; // the same contract, without zlib (inflate_portable.hpp)
+InflateStream::InflateStream(const ByteInput& input, std::uint64_t offset, std::uint64_t size, std::string label)
+    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_(new unsigned char[kBlock])
+{
+    // the portable inflater reads memory: the compressed stream is read whole (a build without
+    // zlib, the WebAssembly one, holds its files in memory anyway)
+    whole_.resize(static_cast<std::size_t>(size_));
+    if (size_ > 0) in_.read(offset_, reinterpret_cast<unsigned char*>(whole_.data()), whole_.size());
+    portable_ = std::make_unique<PortableInflater>(whole_, label_);
+}
+
+InflateStream::~InflateStream() = default;
+
+std::uint64_t InflateStream::consumed() const noexcept { return portable_->consumed(); }
+
+std::size_t InflateStream::produce(unsigned char* out, std::size_t count)
+{
+    const std::size_t done = portable_->produce(out, count); // gzip members one after another too
+    ended_ = portable_->ended();
+    produced_ += done;
+    return done;
+}
+
 #endif
 
-} // namespace
+void InflateStream::read_exactly(unsigned char* out, std::size_t count, std::uint64_t wanted)
+{
+    if (produce(out, count) < count) fail_short(wanted);
+}
+
+void InflateStream::skip(std::uint64_t count, std::uint64_t wanted)
+{
+    std::array<unsigned char, 1 << 16> scratch{};
+    while (count > 0) {
+        const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(count, scratch.size()));
+        read_exactly(scratch.data(), n, wanted);
+        count -= n;
+    }
+}
+
+void InflateStream::fail_short(std::uint64_t wanted) const
+{
+    if (ended_) {
+        throw Error(Status::truncated_file, label_ + ": the compressed stream holds only " + std::to_string(produced_) +
+                                                " bytes but the header declares " + std::to_string(wanted));
+    }
+    throw Error(Status::truncated_file, label_ + ": the compressed stream ends early, after " +
+                                            std::to_string(produced_) + " of the " + std::to_string(wanted) +
+                                            " declared bytes (file cut short?)");
+}
+
+void InflateStream::finish(std::uint64_t wanted)
+{
+    // Everything declared is there; the stream must now end (its trailer holds the checksum).
+    if (!ended_) {
+        unsigned char one = 0;
+        if (produce(&one, 1) != 0) {
+            throw Error(Status::bad_format, label_ + ": the compressed stream holds more than the " +
+                                                std::to_string(wanted) + " bytes the header declares");
+        }
+        if (!ended_) {
+            throw Error(Status::truncated_file,
+                        label_ + ": the compressed stream ends before its end marker and checksum (file cut short?)");
+        }
+    }
+    // Only zero padding may follow the stream.
+    for (std::uint64_t at = consumed(); at < size_;) {
+        const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - at, kBlock));
+        in_.read(offset_ + at, block_.get(), n);
+        const auto* first = std::find_if(block_.get(), block_.get() + n, [](unsigned char c) { return c != 0; });
+        if (first != block_.get() + n) {
+            const std::uint64_t junk = at + static_cast<std::uint64_t>(first - block_.get());
+            throw Error(Status::bad_format,
+                        label_ + ": " + std::to_string(size_ - junk) +
+                            " bytes that are not zero padding follow the end of the compressed stream (at byte " +
+                            std::to_string(junk) + " of " + std::to_string(size_) + ")");
+        }
+        at += n;
+    }
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
+    // the block no longer feeds zlib: nothing reads it after this
+    z_->avail_in = 0;
+    fed_ = size_;
+#endif
+}
 
 namespace {
 
@@ -357,28 +421,10 @@ private:
 std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t skip,
                                            std::size_t out_size, const std::string& label)
 {
-    Inflater inflater(in, label);
+    const MemoryInput input(in, label);
+    InflateStream inflater(input, 0, in.size(), label);
     const std::uint64_t wanted = skip + out_size;
-    std::uint64_t got = 0;
-    auto fail_short = [&] {
-        if (inflater.ended()) {
-            throw Error(Status::truncated_file,
-                        label + ": the compressed stream holds only " + std::to_string(got) +
-                            " bytes but the header declares " + std::to_string(wanted));
-        }
-        throw Error(Status::truncated_file,
-                    label + ": the compressed stream ends early, after " + std::to_string(got) +
-                        " of the " + std::to_string(wanted) + " declared bytes (file cut short?)");
-    };
-
-    std::array<unsigned char, 1 << 16> scratch{};
-    while (got < skip) {
-        const std::size_t n =
-            static_cast<std::size_t>(std::min<std::uint64_t>(skip - got, scratch.size()));
-        const std::size_t made = inflater.produce(scratch.data(), n);
-        got += made;
-        if (made < n) fail_short();
-    }
+    inflater.skip(skip, wanted);
     // Real volumes compress a few times; start at 16 times the stream (at least 1 MiB, never
     // more than declared) and double while the stream keeps producing.
     constexpr std::size_t kRatioGuess = 16;
@@ -390,37 +436,12 @@ std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t sk
     std::size_t filled = 0;
     while (true) {
         const std::size_t room = buffer.capacity() - filled;
-        const std::size_t made = inflater.produce(buffer.data() + filled, room);
-        filled += made;
-        got += made;
-        if (made < room) fail_short();
+        inflater.read_exactly(buffer.data() + filled, room, wanted);
+        filled += room;
         if (buffer.full()) break;
         buffer.grow(filled);
     }
-
-    // Everything declared is there; the stream must now end (its trailer holds the checksum).
-    if (!inflater.ended()) {
-        if (inflater.produce(scratch.data(), 1) != 0) {
-            throw Error(Status::bad_format, label + ": the compressed stream holds more than the " +
-                                                std::to_string(wanted) +
-                                                " bytes the header declares");
-        }
-        if (!inflater.ended()) {
-            throw Error(Status::truncated_file,
-                        label + ": the compressed stream ends before its end marker and "
-                                "checksum (file cut short?)");
-        }
-    }
-    const std::string_view rest = in.substr(inflater.consumed());
-    const std::size_t junk = rest.find_first_not_of('\0');
-    if (junk != std::string_view::npos) {
-        throw Error(Status::bad_format,
-                    label + ": " + std::to_string(rest.size() - junk) +
-                        " bytes that are not zero padding follow the end of the compressed "
-                        "stream (at byte " +
-                        std::to_string(inflater.consumed() + junk) + " of " +
-                        std::to_string(in.size()) + ")");
-    }
+    inflater.finish(wanted);
     return buffer.release();
 }
 

@@ -22,7 +22,11 @@
 
 #include "cmc33/io.hpp"
 
+struct z_stream_s; // zlib's z_stream
+
 namespace cmc33::io::detail {
+
+class PortableInflater; // inflate_portable.hpp: InflateStream's engine in builds without zlib
 
 /// Bytes that can be read by (offset, count). The size is fixed when the input is opened.
 class ByteInput {
@@ -120,6 +124,52 @@ inline void to_native(std::byte* data, std::size_t count, std::size_t width, End
 /// in bytes, and starts the message after the label.
 void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const std::string& label,
                          const std::string& what);
+
+/// A zlib or gzip stream (gzip members may follow one another) in bytes [offset, offset + size)
+/// of `input`, read a block at a time and inflated on demand: its memory is one block and zlib's
+/// window, whatever the stream's size. inflate_exact() is built on it; so is the reading of
+/// compressed volumes plane by plane (plane_reader.hpp). Messages start with `label`.
+class InflateStream {
+public:
+    InflateStream(const ByteInput& input, std::uint64_t offset, std::uint64_t size, std::string label);
+    ~InflateStream();
+    InflateStream(const InflateStream&) = delete;
+    InflateStream& operator=(const InflateStream&) = delete;
+
+    /// Writes up to `count` bytes to `out`; fewer only when the input ended (then `ended()` says
+    /// whether the stream was complete). Returns how many were written.
+    /// @throws Error{bad_format} for corrupt data
+    std::size_t produce(unsigned char* out, std::size_t count);
+    /// Exactly `count` bytes, or Error{truncated_file} saying the stream holds fewer than the
+    /// `wanted` bytes the header declares.
+    void read_exactly(unsigned char* out, std::size_t count, std::uint64_t wanted);
+    /// Inflates and drops `count` bytes (as read_exactly).
+    void skip(std::uint64_t count, std::uint64_t wanted);
+    /// After all `wanted` declared bytes came out: the stream must end there, and only zero bytes
+    /// may follow it. @throws Error{bad_format} for more data or junk, Error{truncated_file} for a
+    /// stream without its end.
+    void finish(std::uint64_t wanted);
+    bool ended() const noexcept { return ended_; }
+    std::uint64_t produced() const noexcept { return produced_; }
+
+private:
+    [[noreturn]] void fail_short(std::uint64_t wanted) const;
+    std::uint64_t consumed() const noexcept;
+    static constexpr std::size_t kBlock = std::size_t{1} << 20;
+    static constexpr std::size_t kMaxOut = std::size_t{1} << 30; // zlib counts in 32-bit uInt
+    const ByteInput& in_;
+    std::uint64_t offset_, size_;
+    std::string label_;
+    std::unique_ptr<unsigned char[]> block_;
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
+    std::unique_ptr<z_stream_s> z_;
+#else
+    std::string whole_; ///< the compressed stream (the portable inflater reads memory)
+    std::unique_ptr<PortableInflater> portable_;
+#endif
+    std::uint64_t fed_ = 0, produced_ = 0;
+    bool ended_ = false;
+};
 
 /// Inflates the zlib or gzip stream in `in` (the kind is detected from its first bytes; gzip
 /// members may follow one another), discards its first `skip` bytes, and returns the next

@@ -18,6 +18,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
+#include "cmc33/io_export.hpp"
 
 namespace cmc33::io::detail {
 
@@ -27,6 +28,14 @@ Mesh read_stl(std::string_view bytes, const std::string& name);
 Mesh read_off(std::string_view bytes, const std::string& name);
 
 void write_ply(const Mesh& mesh, std::ostream& out, bool ascii);
+/// The header write_ply writes for a mesh of these sizes. A binary file continues with
+/// kPlyVertexBytes (kPlyNormalVertexBytes with normals) per vertex, then kPlyFaceBytes per
+/// triangle, so a writer that knows the sizes can place any slice of the mesh (out-of-core slabs,
+/// MPI ranks: src/slabs) at its offset.
+CMC33_IO_EXPORT std::string ply_header(std::uint64_t vertices, std::uint64_t triangles, bool normals, bool ascii);
+inline constexpr std::size_t kPlyVertexBytes = 12;       ///< float x y z
+inline constexpr std::size_t kPlyNormalVertexBytes = 24; ///< float x y z nx ny nz
+inline constexpr std::size_t kPlyFaceBytes = 13;         ///< uchar 3, uint a b c
 void write_obj(const Mesh& mesh, std::ostream& out);
 void write_stl(const Mesh& mesh, std::ostream& out);
 void write_off(const Mesh& mesh, std::ostream& out);

@@ -143,7 +143,7 @@ std::string met_type_name(ScalarType type)
 
 } // namespace
 
-Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
+Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data, const ReadSamples& read)
 {
     const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "MetaImage");
@@ -270,7 +270,7 @@ Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
     const std::string& name = data_file->value;
     if (equals_ignore_case(name, "LOCAL")) {
         storage.offset = source.position();
-        return read_samples(file, grid, storage, label);
+        return read(file, grid, storage, label, nullptr);
     }
     if (name == "LIST" || name.rfind("LIST ", 0) == 0) {
         throw Error(Status::unsupported_format,
@@ -305,7 +305,7 @@ Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data)
             storage.offset = static_cast<std::uint64_t>(skip);
         }
     }
-    return read_samples(data, grid, storage, data.label());
+    return read(data, grid, storage, data.label(), nullptr);
 }
 
 void write_metaimage(const Volume& volume, const std::filesystem::path& path, bool local)

@@ -346,7 +346,7 @@ std::string nrrd_type_name(ScalarType type)
 
 } // namespace
 
-Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header)
+Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header, const ReadSamples& read)
 {
     const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "NRRD");
@@ -552,7 +552,7 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
             storage.offset += static_cast<std::uint64_t>(skip);
         }
     }
-    return read_samples(data, grid, storage, data_label);
+    return read(data, grid, storage, data_label, nullptr);
 }
 
 void write_nrrd(const Volume& volume, const std::filesystem::path& path, bool detached)

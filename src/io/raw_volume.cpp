@@ -13,7 +13,7 @@
 
 namespace cmc33::io::detail {
 
-Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw)
+Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw, const ReadSamples& read)
 {
     const std::string& label = file.label();
     if (!raw) {
@@ -70,7 +70,7 @@ Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw)
     storage.encoding = Encoding::raw;
     storage.endian = options.endian;
     storage.offset = options.header_bytes;
-    return read_samples(file, grid, storage, label);
+    return read(file, grid, storage, label, nullptr);
 }
 
 std::filesystem::path data_file_beside(const std::filesystem::path& header)

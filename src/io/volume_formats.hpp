@@ -139,6 +139,24 @@ struct Storage {
 Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
                     const std::string& label, std::uint64_t* end = nullptr);
 
+/// The last step of every reader: read_samples, or what a caller that reads the samples itself
+/// puts in its place (describe_volume() of plane_reader.hpp records the layout instead).
+using ReadSamples = std::function<Volume(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                         const std::string& label, std::uint64_t* end)>;
+
+/// The checks read_samples makes on raw samples before reading them: where they start (past a
+/// `storage.at_end` file's other bytes), with Error{truncated_file} or Error{bad_format} when
+/// the file holds fewer or more bytes than `grid` declares.
+std::uint64_t check_raw_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                const std::string& label);
+/// The checks read_samples makes on compressed samples before inflating them; returns the
+/// stream's size. Error{truncated_file} if the stream cannot hold the declared samples.
+std::uint64_t check_compressed_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                       const std::string& label);
+/// The check read_samples makes after inflating: Error{bad_format} for bytes after a stream
+/// whose size the header declared (unless `storage.check_trailing` is false).
+void check_after_stream(const ByteInput& file, const Storage& storage, std::uint64_t stream, const std::string& label);
+
 /// Fills `volume` from decimal text: blank-separated values, the last one followed by blanks or
 /// by the end of the text. Returns the offset just past the last value.
 /// @throws Error{truncated_file} (too few values), Error{bad_format} (not a number, out of range).
@@ -154,11 +172,14 @@ void write_samples(std::ostream& out, const Volume& volume, Endian endian);
 using OpenDataFile = std::function<std::unique_ptr<ByteInput>(std::string_view name)>;
 
 /// NRRD, attached or detached; `detached_header` (a .nhdr file) requires a "data file" field.
-Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header);
+/// Each reader parses and checks its header, then hands the samples' layout to `read` (which
+/// reads them, unless a caller put another step there).
+Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool detached_header,
+                 const ReadSamples& read = read_samples);
 /// MetaImage, .mha (ElementDataFile = LOCAL) or .mhd (a data file).
-Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data);
-Volume read_vtk(const ByteInput& file);
-Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw);
+Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data, const ReadSamples& read = read_samples);
+Volume read_vtk(const ByteInput& file, const ReadSamples& read = read_samples);
+Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw, const ReadSamples& read = read_samples);
 
 /// The data file a detached header names: "<stem>.raw" in the header's folder.
 std::filesystem::path data_file_beside(const std::filesystem::path& header);

@@ -425,6 +425,78 @@ std::size_t parse_ascii_samples(std::string_view text, Volume& volume, const std
     });
 }
 
+std::uint64_t check_raw_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                const std::string& label)
+{
+    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
+    const std::uint64_t size = file.size();
+    if (storage.offset > size) {
+        throw Error(Status::truncated_file,
+                    str_cat(label, ": the samples should start at byte ", storage.offset,
+                            " but the file has only ", size, " bytes (file cut short?)"));
+    }
+    const std::uint64_t available = size - storage.offset;
+    if (available < bytes) {
+        throw Error(Status::truncated_file,
+                    str_cat(label, ": ", declared(grid, bytes), " but only ", available,
+                            " bytes follow byte ", storage.offset,
+                            " (file cut short, or wrong sizes?)"));
+    }
+    if (available > bytes && !storage.at_end && storage.check_trailing) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": ", declared(grid, bytes), " but ", available,
+                            " bytes follow byte ", storage.offset, ": ", available - bytes,
+                            " more after the samples (wrong sizes, or data appended?)"));
+    }
+    return storage.at_end ? size - bytes : storage.offset;
+}
+
+std::uint64_t check_compressed_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                       const std::string& label)
+{
+    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
+    const std::uint64_t size = file.size();
+    if (storage.offset > size) {
+        throw Error(Status::truncated_file,
+                    str_cat(label, ": the samples should start at byte ", storage.offset,
+                            " but the file has only ", size, " bytes (file cut short?)"));
+    }
+    const std::uint64_t available = size - storage.offset;
+    std::uint64_t stream = available;
+    if (storage.stored_size) {
+        if (*storage.stored_size > available) {
+            throw Error(Status::truncated_file,
+                        str_cat(label, ": the header declares ", *storage.stored_size,
+                                " compressed bytes but only ", available, " follow byte ",
+                                storage.offset,
+                                " (file cut short, or wrong compressed size?)"));
+        }
+        stream = *storage.stored_size;
+    }
+    // Nothing of the declared size is allocated unless the stream could hold it, and then
+    // only as much as the stream really yields.
+    const std::uint64_t inflated = storage.skip_inflated + bytes;
+    check_inflate_bound(stream, inflated,
+                        label, storage.skip_inflated == 0
+                                   ? declared(grid, bytes)
+                                   : str_cat(declared(grid, bytes), " after ",
+                                             storage.skip_inflated, " skipped bytes (",
+                                             inflated, " in all)"));
+    return stream;
+}
+
+void check_after_stream(const ByteInput& file, const Storage& storage, std::uint64_t stream, const std::string& label)
+{
+    const std::uint64_t available = file.size() - storage.offset;
+    if (stream < available && storage.check_trailing) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": the header declares ", stream,
+                            " compressed bytes but ", available, " follow byte ",
+                            storage.offset, ": ", available - stream,
+                            " more after the stream (wrong compressed size?)"));
+    }
+}
+
 Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
                     const std::string& label, std::uint64_t* end)
 {
@@ -440,19 +512,7 @@ Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& stor
 
     switch (storage.encoding) {
     case Encoding::raw: {
-        if (available < bytes) {
-            throw Error(Status::truncated_file,
-                        str_cat(label, ": ", declared(grid, bytes), " but only ", available,
-                                " bytes follow byte ", storage.offset,
-                                " (file cut short, or wrong sizes?)"));
-        }
-        if (available > bytes && !storage.at_end && storage.check_trailing) {
-            throw Error(Status::bad_format,
-                        str_cat(label, ": ", declared(grid, bytes), " but ", available,
-                                " bytes follow byte ", storage.offset, ": ", available - bytes,
-                                " more after the samples (wrong sizes, or data appended?)"));
-        }
-        const std::uint64_t offset = storage.at_end ? size - bytes : storage.offset;
+        const std::uint64_t offset = check_raw_samples(file, grid, storage, label);
         Volume volume = allocate(grid, label);
         file.read(offset, volume.bytes(), volume.byte_size());
         to_native(volume.bytes(), static_cast<std::size_t>(volume.sample_count()), width,
@@ -461,36 +521,11 @@ Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& stor
         return volume;
     }
     case Encoding::compressed: {
-        std::uint64_t stream = available;
-        if (storage.stored_size) {
-            if (*storage.stored_size > available) {
-                throw Error(Status::truncated_file,
-                            str_cat(label, ": the header declares ", *storage.stored_size,
-                                    " compressed bytes but only ", available, " follow byte ",
-                                    storage.offset,
-                                    " (file cut short, or wrong compressed size?)"));
-            }
-            stream = *storage.stored_size;
-        }
-        // Nothing of the declared size is allocated unless the stream could hold it, and then
-        // only as much as the stream really yields.
-        const std::uint64_t inflated = storage.skip_inflated + bytes;
-        check_inflate_bound(stream, inflated,
-                            label, storage.skip_inflated == 0
-                                       ? declared(grid, bytes)
-                                       : str_cat(declared(grid, bytes), " after ",
-                                                 storage.skip_inflated, " skipped bytes (",
-                                                 inflated, " in all)"));
+        const std::uint64_t stream = check_compressed_samples(file, grid, storage, label);
         const std::string compressed = file.read_string(storage.offset, stream);
         std::unique_ptr<std::byte[]> samples = inflate_exact(
             compressed, storage.skip_inflated, static_cast<std::size_t>(bytes), label);
-        if (stream < available && storage.check_trailing) {
-            throw Error(Status::bad_format,
-                        str_cat(label, ": the header declares ", stream,
-                                " compressed bytes but ", available, " follow byte ",
-                                storage.offset, ": ", available - stream,
-                                " more after the stream (wrong compressed size?)"));
-        }
+        check_after_stream(file, storage, stream, label);
         to_native(samples.get(), static_cast<std::size_t>(bytes / width), width, storage.endian);
         if (end) *end = storage.offset + stream;
         try {

@@ -178,7 +178,7 @@ void check_after_samples(const ByteInput& file, std::uint64_t end, std::int64_t 
 
 } // namespace
 
-Volume read_vtk(const ByteInput& file)
+Volume read_vtk(const ByteInput& file, const ReadSamples& read)
 {
     const std::string& label = file.label();
     const std::string head = read_header_bytes(file, "VTK legacy");
@@ -303,7 +303,7 @@ Volume read_vtk(const ByteInput& file)
     storage.offset = source.position();
     storage.check_trailing = false; // other attributes may follow: checked here
     std::uint64_t end = 0;
-    Volume volume = read_samples(file, grid, storage, label, &end);
+    Volume volume = read(file, grid, storage, label, &end);
     check_after_samples(file, end, expected, label);
     return volume;
 }

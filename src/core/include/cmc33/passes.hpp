@@ -54,6 +54,13 @@ public:
     std::int64_t triangle_count() const noexcept { return triangles_; }
     /// Crossed cells of the range per subcase (see subcase_name()).
     const ExtractStats& stats() const noexcept { return stats_; }
+    /// A bound on |sample| over the planes the range read, which scales emit()'s gradients when
+    /// samples come near the double range. extract() gives every range the largest bound of them
+    /// all; ranges counted apart (MPI ranks, out-of-core slabs) get extract()'s normals byte for
+    /// byte by doing the same: share_sample_bound(the largest sample_bound() of all ranges).
+    double sample_bound() const noexcept { return largest_sample_; }
+    /// Raises the bound to `bound` (never lowers it: a lower bound could overflow the gradients).
+    void share_sample_bound(double bound) noexcept { largest_sample_ = bound > largest_sample_ ? bound : largest_sample_; }
 
 private:
     template <class T> friend class RangeExtractor;
