@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz]
-#   --bench  also the peers the benchmark compares against (VTK, scikit-image)
-#   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+# Idempotent and quiet when everything is present.
+# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--python]
+#   --bench   also the peers the benchmark compares against (VTK, scikit-image)
+#   --fuzz    also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --python  also what the Python package needs to build, test and show its examples (python/,
+#             scripts/test-python.sh): pybind11, numpy, setuptools, venv, build, pytest, and the
+#             peers its tests and README use (scikit-image, meshio, VTK)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
@@ -13,7 +17,10 @@ for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev libvtk9-dev python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
+    --python) packages+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-wheel
+                         python3-venv python3-pip python3-build python3-pytest python3-skimage python3-meshio
+                         python3-vtk9) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz or --python" >&2; exit 2 ;;
     esac
 done
 
