@@ -93,85 +93,106 @@ public:
         m.triangles.resize(static_cast<std::size_t>(nt) * 3);
         m.vertex_count = nv;
         m.triangle_count = nt;
+        std::vector<std::vector<SeamValue>> seams(static_cast<std::size_t>(ranges));
         run_ranges(n, ranges, control, 0.5, 0.5, [&](int r) {
-            emit_range(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], m);
+            const auto i = static_cast<std::size_t>(r);
+            emit_range(counts[i], offsets[i], m, seams[i]);
         });
+        for (const std::vector<SeamValue>& seam : seams)
+            for (const SeamValue& s : seam) m.values[s.vertex] = std::max(m.values[s.vertex], s.value);
         if (o_.mask) compact(m);
         return m;
     }
 
 private:
-    /// Emits one range into m and finishes its part: values, winding, masked triangles marked.
-    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m) const
+    /// A value for a vertex of the next range, set once every range is done.
+    struct SeamValue {
+        std::uint32_t vertex;
+        float value;
+    };
+
+    /// Emits one range into m and finishes its part: values, winding, masked triangles marked
+    /// (triangles run cell by cell: each cell's range is computed once).
+    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, std::vector<SeamValue>& seam) const
     {
         const auto fv = static_cast<std::size_t>(at.first_vertex);
         const auto ft = static_cast<std::size_t>(at.first_triangle);
         const auto nv = static_cast<std::size_t>(c.vertex_count());
         const auto nt = static_cast<std::size_t>(c.triangle_count());
-        // the range's own edge ids and triangle cells: a few bytes per vertex of one range at a time
-        std::vector<std::int64_t> edges(nv);
-        std::vector<std::int64_t> cells(o_.mask ? nt : 0);
+        std::vector<std::int64_t> cells(nt); // the range's triangles' cells: 8 bytes a triangle of one range
         MeshSpans out;
         out.positions = m.positions.data() + 3 * fv;
         out.normals = m.normals.data() + 3 * fv;
         out.triangles = m.triangles.data() + 3 * ft;
-        out.vertex_edges = edges.data();
-        out.triangle_cells = o_.mask ? cells.data() : nullptr;
+        out.triangle_cells = cells.data();
         out.first_vertex = at.first_vertex;
         out.first_triangle = at.first_triangle;
         emit(g_, iso_, options_, c, at, out);
 
-        for (std::size_t v = 0; v < nv; ++v) m.values[fv + v] = vertex_value(edges[v]);
+        // scikit-image's values: per vertex, the largest range among the kept cells whose
+        // triangles use it. This range's triangles also use the next range's first plane:
+        // those go to `seam`, so that no two ranges write one value.
+        float* values = m.values.data();
+        std::fill(values + fv, values + fv + nv, 0.0f);
+        Decoder decode(g_.nx(), g_.ny());
+        std::int64_t cell = -1;
+        float range = 0;
+        bool kept = true;
         std::uint32_t* t = m.triangles.data() + 3 * ft;
-        if (o_.descent) {
-            for (std::size_t f = 0; f < nt; ++f) std::swap(t[3 * f + 1], t[3 * f + 2]);
-        }
-        if (o_.mask) {
-            for (std::size_t f = 0; f < nt; ++f) {
-                const Index3 cell = decode(cells[f]);
-                if (!(*o_.mask)(cell[0], cell[1], cell[2])) t[3 * f] = kDropped;
+        for (std::size_t f = 0; f < nt; ++f, t += 3) {
+            if (cells[f] != cell) {
+                cell = cells[f];
+                const Index3 corner = decode(cell);
+                kept = !o_.mask || (*o_.mask)(corner[0], corner[1], corner[2]);
+                range = static_cast<float>(cell_range(corner));
             }
+            if (!kept) {
+                t[0] = kDropped;
+                continue;
+            }
+            for (std::size_t k = 0; k < 3; ++k) {
+                const std::uint32_t v = t[k];
+                if (v - fv < nv) {
+                    values[v] = std::max(values[v], range);
+                } else {
+                    seam.push_back({v, range});
+                }
+            }
+            if (o_.descent) std::swap(t[1], t[2]);
         }
     }
 
-    Index3 decode(std::int64_t index) const noexcept
-    {
-        const std::int64_t nx = g_.nx(), ny = g_.ny();
-        return {index % nx, (index / nx) % ny, index / (nx * ny)};
-    }
+    /// (i, j, k) of a cell index i + nx * (j + ny * k). Triangles come cell row by cell row, so
+    /// the row of the previous index is kept and the divisions are done once per row.
+    class Decoder {
+    public:
+        Decoder(std::int64_t nx, std::int64_t ny) noexcept : nx_(nx), ny_(ny) {}
+        Index3 operator()(std::int64_t index) noexcept
+        {
+            if (index < first_ || index >= first_ + nx_) {
+                const std::int64_t row = index / nx_;
+                first_ = row * nx_;
+                j_ = row % ny_;
+                k_ = row / ny_;
+            }
+            return {index - first_, j_, k_};
+        }
 
-    /// Largest minus smallest corner sample of cell (i, j, k).
-    double cell_range(std::int64_t i, std::int64_t j, std::int64_t k) const noexcept
+    private:
+        std::int64_t nx_, ny_, first_ = std::numeric_limits<std::int64_t>::min() / 2, j_ = 0, k_ = 0;
+    };
+
+    /// Largest minus smallest corner sample of the cell with lowest corner c.
+    double cell_range(const Index3& c) const noexcept
     {
-        const T* p = g_.data + g_.offset(i, j, k);
+        const T* p = g_.data + g_.offset(c[0], c[1], c[2]);
         const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
-        const T corners[8] = {p[0], p[sx], p[sy], p[sx + sy], p[sz], p[sx + sz], p[sy + sz], p[sx + sy + sz]};
-        const auto [lo, hi] = std::minmax_element(std::begin(corners), std::end(corners));
-        return static_cast<double>(*hi) - static_cast<double>(*lo);
-    }
-
-    /// scikit-image's value of a vertex: the largest cell_range of the kept cells that use it
-    /// (an interior vertex: its cell; an edge vertex: the up to four cells around its edge).
-    float vertex_value(std::int64_t edge) const noexcept
-    {
-        if (edge < 0) {
-            const Index3 c = decode(-1 - edge);
-            return static_cast<float>(cell_range(c[0], c[1], c[2]));
-        }
-        const auto axis = static_cast<std::size_t>(edge % 3);
-        const Index3 s = decode(edge / 3);
-        const std::size_t p = (axis + 1) % 3, q = (axis + 2) % 3; // the axes across the edge
-        double best = 0;
-        for (std::int64_t a = 0; a < 2; ++a)
-            for (std::int64_t b = 0; b < 2; ++b) {
-                Index3 c = s;
-                c[p] -= a;
-                c[q] -= b;
-                if (c[p] < 0 || c[q] < 0 || c[p] > g_.dims[p] - 2 || c[q] > g_.dims[q] - 2) continue;
-                if (o_.mask && !(*o_.mask)(c[0], c[1], c[2])) continue;
-                best = std::max(best, cell_range(c[0], c[1], c[2]));
-            }
-        return static_cast<float>(best);
+        // pairs, then a tree: no branch (std::minmax_element's would mispredict on noisy data)
+        const T a0 = p[0], a1 = p[sx], a2 = p[sy], a3 = p[sx + sy];
+        const T a4 = p[sz], a5 = p[sx + sz], a6 = p[sy + sz], a7 = p[sx + sy + sz];
+        const T lo = std::min(std::min(std::min(a0, a1), std::min(a2, a3)), std::min(std::min(a4, a5), std::min(a6, a7)));
+        const T hi = std::max(std::max(std::max(a0, a1), std::max(a2, a3)), std::max(std::max(a4, a5), std::max(a6, a7)));
+        return static_cast<double>(hi) - static_cast<double>(lo);
     }
 
     /// Drops the marked triangles and the vertices no kept triangle uses, keeping the order of
