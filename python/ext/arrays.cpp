@@ -50,14 +50,19 @@ bool native_order(char byteorder) noexcept
 }
 
 /// Smallest and largest sample over the view, NaN skipped: the innermost loop runs along the
-/// axis with the smallest stride, whatever the layout; the outermost axis is split among threads.
-template <class T> std::pair<double, double> range_of(const Samples& s, int threads)
+/// axis with the smallest stride, whatever the layout; the outermost axis is split among threads,
+/// which stop early when control says so (Error{cancelled}).
+template <class T> std::pair<double, double> range_of(const Samples& s, int threads, Control& control)
 {
     std::array<int, 3> axes{0, 1, 2};
     std::sort(axes.begin(), axes.end(), [&](int a, int b) {
         return std::llabs(s.strides[static_cast<std::size_t>(a)]) < std::llabs(s.strides[static_cast<std::size_t>(b)]);
     });
-    const auto dim = [&](int a) { return s.dims[static_cast<std::size_t>(a)]; };
+    // an axis of stride 0 (np.broadcast_to) repeats its samples: one of them is enough
+    const auto dim = [&](int a) {
+        return s.strides[static_cast<std::size_t>(a)] == 0 ? std::min<std::int64_t>(s.dims[static_cast<std::size_t>(a)], 1)
+                                                            : s.dims[static_cast<std::size_t>(a)];
+    };
     const auto stride = [&](int a) { return s.strides[static_cast<std::size_t>(a)]; };
     const std::int64_t n0 = dim(axes[0]), n1 = dim(axes[1]), n2 = dim(axes[2]);
     const std::int64_t s0 = stride(axes[0]), s1 = stride(axes[1]), s2 = stride(axes[2]);
@@ -70,7 +75,7 @@ template <class T> std::pair<double, double> range_of(const Samples& s, int thre
     std::vector<std::pair<T, T>> found(static_cast<std::size_t>(n), {kHigh, kLow});
     const auto part = [&](int t) {
         T lo = kHigh, hi = kLow;
-        for (std::int64_t c = n2 * t / n; c < n2 * (t + 1) / n; ++c)
+        for (std::int64_t c = n2 * t / n; c < n2 * (t + 1) / n && !control.stopped(); ++c)
             for (std::int64_t b = 0; b < n1; ++b) {
                 const T* row = base + c * s2 + b * s1;
                 if (s0 == 1) { // comparisons are false for NaN: it is skipped
@@ -92,6 +97,7 @@ template <class T> std::pair<double, double> range_of(const Samples& s, int thre
     for (int t = 1; t < n; ++t) pool.emplace_back(part, t);
     part(0);
     for (std::thread& th : pool) th.join();
+    if (control.stopped()) throw Error(Status::cancelled, "value range cancelled");
     T lo = kHigh, hi = kLow;
     for (const auto& [l, h] : found) {
         lo = std::min(lo, l);
@@ -147,12 +153,11 @@ std::pair<double, double> value_range(const Samples& samples, int threads)
     if (samples.count() == 0) {
         throw Error(Status::invalid_argument, "the volume has no samples; expected at least one");
     }
-    std::pair<double, double> r;
-    {
-        py::gil_scoped_release nogil;
-        r = dispatch_scalar_type(samples.type, [&](auto tag) { return range_of<decltype(tag)>(samples, threads); });
-    }
-    return r;
+    return run_interruptible<std::pair<double, double>>(
+        samples.count() >= kBackgroundSamples, py::none(), [&](Control& control) {
+            return dispatch_scalar_type(samples.type,
+                                        [&](auto tag) { return range_of<decltype(tag)>(samples, threads, control); });
+        });
 }
 
 int resolve_threads(int threads) noexcept

@@ -42,10 +42,6 @@ struct Samples {
 ///         of samples. The Python layer (cmc33/_arrays.py) converts other arrays first.
 Samples samples_of(const py::array& array, const char* what = "volume");
 
-/// Smallest and largest sample, NaN skipped (NaN, NaN if every sample is NaN); without the GIL.
-/// @throws Error{invalid_argument} for an empty array
-std::pair<double, double> value_range(const Samples& samples, int threads);
-
 /// The frame of volume.hpp: spacing, origin and direction of the library's axes x, y, z.
 struct Frame {
     Vec3 spacing{1, 1, 1};
@@ -151,6 +147,10 @@ template <class R> R run_interruptible(bool background, const py::object& progre
     if (!progress.is_none()) progress(1.0);
     return std::move(*result);
 }
+
+/// Smallest and largest sample, NaN skipped (NaN, NaN if every sample is NaN); without the GIL,
+/// interruptible as run_interruptible is. @throws Error{invalid_argument} for an empty array
+std::pair<double, double> value_range(const Samples& samples, int threads);
 
 /// Number of worker threads for `threads` (0: every core the machine has).
 int resolve_threads(int threads) noexcept;
