@@ -63,6 +63,9 @@ class CMakeBuild(build_ext):
 
 setup(
     version=project_version(),
+    package_dir={"": "src"},
+    packages=["cmc33"],
+    package_data={"cmc33": ["py.typed", "*.pyi"]},
     ext_modules=[CMakeExtension("cmc33._cmc33")],
     cmdclass={"build_ext": CMakeBuild},
 )
