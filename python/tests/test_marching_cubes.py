@@ -87,6 +87,12 @@ def test_skimage_keyword_calls_work_unchanged(skimage_mc):
         assert values.shape == (len(verts),)
 
 
+def test_a_volume_from_read_volume_is_its_samples():
+    volume = cmc33.read_volume(BUCKY)
+    for a, b in zip(cmc33.marching_cubes(volume, 100.5), cmc33.marching_cubes(volume.samples, 100.5)):
+        assert np.array_equal(a, b)
+
+
 def test_arrays_types_and_shapes():
     verts, faces, normals, values = cmc33.marching_cubes(ellipsoid(), 0.5)
     assert verts.dtype == np.float32 and normals.dtype == np.float32 and values.dtype == np.float32

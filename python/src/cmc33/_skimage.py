@@ -34,7 +34,7 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
 
     Parameters
     ----------
-    volume : (M, N, P) array
+    volume : (M, N, P) array (or a cmc33.Volume: its samples; its frame is not used)
         The samples. int8, uint8, int16, uint16, int32, uint32, float32 and float64 (and bool) are
         read in place in any layout (C or Fortran order, slices such as ``vol[:, ::2, 10:200]``);
         other types are converted first (float16 to float32; int64, uint64 to float64).
@@ -113,7 +113,7 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
     >>> z, y, x = np.mgrid[-1:1:32j, -1:1:32j, -1:1:32j]
     >>> verts, faces, normals, values = cmc33.marching_cubes(x**2 + y**2 + z**2, 0.5)
     """
-    samples = as_samples(volume)
+    samples = as_samples(volume.samples if isinstance(volume, _cmc33.Volume) else volume)
     if min(samples.shape) < 2:
         raise ValueError(f"volume has shape {samples.shape}; expected at least 2x2x2 samples")
     spacing = vec3(spacing, "spacing")
