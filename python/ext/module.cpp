@@ -68,6 +68,7 @@ void translate_errors(std::exception_ptr p)
 struct PyMesh {
     Mesh mesh;
     std::optional<ExtractStats> stats; ///< cells per subcase, for meshes extract() made
+    bool normals = false;              ///< the mesh has normals (an empty mesh too, if asked for)
 };
 
 py::array rows_of(const py::object& owner, const py::dtype& dtype, const void* data, std::size_t rows, ssize columns)
@@ -78,9 +79,16 @@ py::array rows_of(const py::object& owner, const py::dtype& dtype, const void* d
 }
 
 PyMesh mesh_from_arrays(const py::array_t<float, py::array::c_style | py::array::forcecast>& vertices,
-                        const py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>& triangles,
+                        const py::array& triangle_array,
                         const std::optional<py::array_t<float, py::array::c_style | py::array::forcecast>>& normals)
 {
+    const char kind = triangle_array.dtype().kind();
+    if (kind != 'i' && kind != 'u') {
+        throw Error(Status::invalid_argument, "triangles have type " +
+                                                  py::str(static_cast<py::object>(triangle_array.dtype())).cast<std::string>() +
+                                                  "; expected integers");
+    }
+    const auto triangles = py::array_t<std::int64_t, py::array::c_style | py::array::forcecast>::ensure(triangle_array);
     if (vertices.ndim() != 2 || vertices.shape(1) != 3) {
         throw Error(Status::invalid_argument, "vertices have shape " + py::str(vertices.attr("shape")).cast<std::string>() +
                                                   "; expected (V, 3)");
@@ -115,6 +123,7 @@ PyMesh mesh_from_arrays(const py::array_t<float, py::array::c_style | py::array:
         }
         m.mesh.normals.resize(nv * 3);
         if (nv > 0) std::memcpy(m.mesh.normals.data(), normals->data(), nv * 3 * sizeof(float));
+        m.normals = true;
     }
     return m;
 }
@@ -188,7 +197,7 @@ PyMesh extract_py(const py::array& volume, double iso, const Vec3& spacing, cons
         if (background) o.progress = [&control](double fraction) { return control.keep_going(fraction); };
         return visit(s, frame, [&](const auto& grid) { return extract(grid, iso, o, &stats); });
     });
-    return PyMesh{std::move(mesh), stats};
+    return PyMesh{std::move(mesh), stats, normals};
 }
 
 /// marching_cubes' four arrays. `spacing` is in the array's axis order and so are the vertices:
@@ -321,19 +330,19 @@ write_mesh, mesh_topology and mesh_geometry).)")
             "normals",
             [](const py::object& self) -> py::object {
                 const PyMesh& p = self.cast<const PyMesh&>();
-                if (!p.mesh.has_normals()) return py::none();
+                if (!p.normals) return py::none();
                 return rows_of(self, py::dtype::of<float>(), p.mesh.normals.data(), p.mesh.vertex_count(), 3);
             },
             "(V, 3) float32 unit normals, in place; None unless extract(..., normals=True) made them")
-        .def_property_readonly("vertex_count", [](const PyMesh& p) { return p.mesh.vertex_count(); })
-        .def_property_readonly("triangle_count", [](const PyMesh& p) { return p.mesh.triangle_count(); })
+        .def_property_readonly("vertex_count", [](const PyMesh& p) { return p.mesh.vertex_count(); }, "V")
+        .def_property_readonly("triangle_count", [](const PyMesh& p) { return p.mesh.triangle_count(); }, "F")
         .def_property_readonly(
             "cells_per_subcase",
             [](const PyMesh& p) -> py::object { return p.stats ? subcase_counts(*p.stats) : py::none(); },
             "dict subcase name -> number of cells the surface crosses (meshes made by extract; else None)")
         .def("__repr__", [](const PyMesh& p) {
             return "Mesh(" + std::to_string(p.mesh.vertex_count()) + " vertices, " + std::to_string(p.mesh.triangle_count()) +
-                   " triangles" + (p.mesh.has_normals() ? ", normals" : "") + ")";
+                   " triangles" + (p.normals ? ", normals" : "") + ")";
         });
 }
 
@@ -470,7 +479,7 @@ lost range or a cross-check disagreed; ``why`` then says which cell.)")
             return std::vector<FaceReport>(r.faces.begin(), r.faces.end());
         }, "six FaceReports, face f = 2 * axis + side")
         .def_readonly("interior", &CellReport::interior)
-        .def_property_readonly("mesh", [](const CellReport& r) { return PyMesh{r.mesh, std::nullopt}; },
+        .def_property_readonly("mesh", [](const CellReport& r) { return PyMesh{r.mesh, std::nullopt, r.mesh.has_normals()}; },
                                "the cell's triangles in the unit cube (a copy)")
         .def("__repr__", [](const CellReport& r) {
             return "CellReport(case " + std::to_string(r.base_case) + ", subcase " + std::string(subcase_name(r.subcase)) +
@@ -612,7 +621,8 @@ PYBIND11_MODULE(_cmc33, m)
             py::gil_scoped_release nogil;
             mesh = io::read_mesh(path);
         }
-        return PyMesh{std::move(mesh), std::nullopt};
+        const bool normals = mesh.has_normals();
+        return PyMesh{std::move(mesh), std::nullopt, normals};
     }, py::arg("path"));
     m.def("write_mesh", [](const PyMesh& mesh, const std::filesystem::path& path, bool ascii) {
         py::gil_scoped_release nogil;

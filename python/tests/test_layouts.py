@@ -62,6 +62,18 @@ def test_every_type_and_layout_read_in_place_gives_the_same_mesh(dtype):
             assert np.array_equal(a, b), f"{dtype} {name}"
 
 
+def test_a_read_only_memory_map_is_read_in_place(tmp_path):
+    volume = field("int16")
+    np.save(tmp_path / "volume.npy", volume)
+    mapped = np.load(tmp_path / "volume.npy", mmap_mode="r")
+    assert not mapped.flags.writeable
+    assert np.shares_memory(as_samples(mapped), mapped)
+    iso = float(np.quantile(volume, 0.6)) + 0.5
+    mesh = cmc33.extract(mapped, iso, normals=True)
+    assert mesh.triangle_count > 100
+    assert mesh_bytes(mesh) == mesh_bytes(cmc33.extract(volume, iso, normals=True))
+
+
 def test_bool_is_read_as_uint8_in_place():
     volume = ellipsoid() > 0
     assert np.shares_memory(as_samples(volume), volume)

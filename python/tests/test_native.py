@@ -53,6 +53,12 @@ def test_normals_only_on_request_unit_and_facing_below():
     assert np.mean((face * mesh.normals[t].sum(axis=1)).sum(axis=1) > 0) > 0.99
 
 
+def test_an_empty_mesh_has_empty_arrays():
+    mesh = cmc33.extract(ellipsoid(), 1000.0, normals=True)  # above every sample
+    assert mesh.vertices.shape == (0, 3) and mesh.triangles.shape == (0, 3) and mesh.normals.shape == (0, 3)
+    assert cmc33.mesh_topology(mesh).faces == 0
+
+
 def test_mesh_from_arrays_copies_and_checks():
     verts, faces, normals, _ = cmc33.marching_cubes(ellipsoid(), 10.0)
     mesh = cmc33.Mesh(verts, faces, normals)
@@ -64,6 +70,8 @@ def test_mesh_from_arrays_copies_and_checks():
         cmc33.Mesh(verts[:, :2], faces)
     with pytest.raises(ValueError, match="integers"):
         cmc33.mesh_topology((verts, faces.astype(float)))
+    with pytest.raises(ValueError, match="integers"):
+        cmc33.Mesh(verts, faces.astype(float))
 
 
 def test_cells_per_subcase_counts_the_crossed_cells():
