@@ -71,7 +71,9 @@ template <class T> std::pair<double, double> range_of(const Samples& s, int thre
     constexpr T kLow = kFloat ? -std::numeric_limits<T>::infinity() : std::numeric_limits<T>::lowest();
     constexpr T kHigh = kFloat ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
 
-    const int n = static_cast<int>(std::clamp<std::int64_t>(resolve_threads(threads), 1, n2));
+    // threads only pay off on large volumes (a thread costs about what 10^5 samples do)
+    const int wanted = s.count() < (std::int64_t{1} << 20) ? 1 : resolve_threads(threads);
+    const int n = static_cast<int>(std::clamp<std::int64_t>(wanted, 1, n2));
     std::vector<std::pair<T, T>> found(static_cast<std::size_t>(n), {kHigh, kLow});
     const auto part = [&](int t) {
         T lo = kHigh, hi = kLow;

@@ -86,7 +86,8 @@ inline constexpr std::int64_t kBackgroundSamples = std::int64_t{1} << 18;
 /// a thread of its own while the calling thread waits, waking every 20 ms to take the GIL, run
 /// Python's pending signal handlers (a Ctrl-C raises KeyboardInterrupt there: PyErr_CheckSignals
 /// only acts on the main thread, which is why the work is not the one to call it) and call
-/// progress(fraction) if that is not None. An exception from either, or progress returning False,
+/// progress(fraction) if that is not None. An exception from either, or progress returning a false
+/// value other than None,
 /// stops the work (control.keep_going() returns false from then on); once the work has ended,
 /// that exception is raised, or Error{cancelled} for the False. progress(1.0) is the last call of
 /// a run that completes (its answer no longer matters).
@@ -130,7 +131,8 @@ template <class R> R run_interruptible(bool background, const py::object& progre
             const double fraction = control.fraction();
             if (!progress.is_none() && fraction != reported) {
                 reported = fraction;
-                if (progress(fraction).ptr() == Py_False) {
+                const py::object answer = progress(fraction);
+                if (!answer.is_none() && PyObject_Not(answer.ptr()) == 1) { // False (or 0, numpy's False)
                     declined = true;
                     control.stop();
                 }

@@ -58,7 +58,9 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         shape (nz, ny, nx): sample (i, j, k) is ``volume[k, j, i]``, so x is the array's last
         axis, as in the files. The eight types int8 ... float64 (and bool) are read in place
         whatever the strides (C or Fortran order, ``vol[:, ::2, 10:200]``, negative steps);
-        other types are converted first (a copy).
+        other types are converted first (a copy). The mesh is the same for every layout; the
+        extractor is fastest when the last axis is contiguous (Fortran order reads along the slow
+        axis, a few times slower: ``np.ascontiguousarray`` trades a copy for that time).
     iso : float
         The isovalue.
     spacing, origin : 3 floats, optional

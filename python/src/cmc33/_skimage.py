@@ -37,7 +37,9 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
     volume : (M, N, P) array (or a cmc33.Volume: its samples; its frame is not used)
         The samples. int8, uint8, int16, uint16, int32, uint32, float32 and float64 (and bool) are
         read in place in any layout (C or Fortran order, slices such as ``vol[:, ::2, 10:200]``);
-        other types are converted first (float16 to float32; int64, uint64 to float64).
+        other types are converted first (float16 to float32; int64, uint64 to float64). The
+        arrays returned are the same for every layout; C order (last axis contiguous) is the
+        fast one: Fortran order is read along the slow axis, a few times slower.
     level : float, optional
         The isovalue; default the middle of the data range, ``(min + max) / 2``. A value outside
         [min, max] raises ValueError, as in scikit-image.
