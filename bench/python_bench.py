@@ -2,13 +2,14 @@
 """Times cmc33.marching_cubes against skimage.measure.marching_cubes from Python, and measures
 that cmc33 reads the volume in place.
 
-    bench/python_bench.py [--cases aneurism,bonsai,CThead,sines512] [--repeat 3] [--volumes DIR]
+    bench/python_bench.py [--cases aneurism,bonsai,bonsai-fortran,CThead,sines512] [--repeat 3] [--volumes DIR]
 
 Run it with the interpreter the package is installed for (a venv made by scripts/test-python.sh:
 build-python/venv/bin/python bench/python_bench.py). For each case the volume is read (or, for
 sines512, computed plane by plane: sin(a x + 0.3) + sin(a y + 0.3) + sin(a z + 0.3) on 512^3
-float32, a = 2 pi 8 / 512, the field of bench/run_bench.sh) outside the timing; then, on the same
-array, each tool is called REPEAT times exactly as a user calls it and the median is reported:
+float32, a = 2 pi 8 / 512, the field of bench/run_bench.sh; bonsai-fortran is bonsai copied to
+Fortran order) outside the timing; then, on the same array, each tool is called REPEAT times
+exactly as a user calls it and the median is reported:
 
   skimage           skimage.measure.marching_cubes(volume, level) (its own float32 conversion
                     included; always single-threaded)
@@ -39,6 +40,7 @@ REPO = Path(__file__).resolve().parents[1]
 CASES = {  # name: (file in the shared volumes or None for the computed field, isovalue)
     "aneurism": ("aneurism_256x256x256_uint8.nrrd", 80.0),
     "bonsai": ("bonsai_256x256x256_uint8.nrrd", 40.0),
+    "bonsai-fortran": ("bonsai_256x256x256_uint8.nrrd", 40.0),  # the same samples in Fortran order
     "CThead": ("CThead_256x256x113_uint16.nrrd", 1500.0),
     "sines512": (None, 0.0),
 }
@@ -60,7 +62,11 @@ def load(case, volumes):
     name, iso = CASES[case]
     if name is None:
         return sines(), iso
-    return cmc33.read_volume(volumes / name).samples, iso
+    samples = cmc33.read_volume(volumes / name).samples
+    if case.endswith("-fortran"):
+        import numpy as np
+        samples = np.asfortranarray(samples)
+    return samples, iso
 
 
 def median_time(call, repeat):
