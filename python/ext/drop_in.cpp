@@ -27,20 +27,21 @@ constexpr std::int64_t kPlanesPerRange = 16;
 constexpr std::int64_t kMinRanges = 32;
 constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
 
-/// Runs job(r) for r in [0, ranges) on n threads (the calling one among them), each range taken by
-/// whichever thread is free. No range starts once control says stop or a job has thrown; then the
-/// error of the lowest range that threw is rethrown, or Error{cancelled}. Reports the fraction
-/// from + share * (ranges done / ranges) to control.
-void run_ranges(int n, int ranges, Control& control, double from, double share, const std::function<void(int)>& job)
+/// Runs job(r, t) for r in [0, ranges) on n threads t = 0 .. n - 1 (0 the calling one), each
+/// range taken by whichever thread is free. No range starts once control says stop or a job has
+/// thrown; then the error of the lowest range that threw is rethrown, or Error{cancelled}.
+/// Reports the fraction from + share * (ranges done / ranges) to control.
+void run_ranges(int n, int ranges, Control& control, double from, double share,
+                const std::function<void(int range, int thread)>& job)
 {
     std::atomic<int> next{0}, done{0};
     std::atomic<bool> failed{false};
     std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ranges));
-    const auto work = [&] {
+    const auto work = [&](int thread) {
         for (int r = next.fetch_add(1); r < ranges; r = next.fetch_add(1)) {
             if (failed.load(std::memory_order_relaxed) || control.stopped()) return;
             try {
-                job(r);
+                job(r, thread);
             } catch (...) {
                 errors[static_cast<std::size_t>(r)] = std::current_exception();
                 failed.store(true, std::memory_order_relaxed);
@@ -50,8 +51,8 @@ void run_ranges(int n, int ranges, Control& control, double from, double share, 
     };
     {
         std::vector<std::jthread> pool;
-        for (int t = 1; t < n; ++t) pool.emplace_back(work);
-        work();
+        for (int t = 1; t < n; ++t) pool.emplace_back(work, t);
+        work(0);
     }
     for (const std::exception_ptr& e : errors) {
         if (e) std::rethrow_exception(e);
@@ -76,7 +77,7 @@ public:
         const auto plane = [&](int r) { return nz * r / ranges; };
 
         std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
-        run_ranges(n, ranges, control, 0, 0.5, [&](int r) {
+        run_ranges(n, ranges, control, 0, 0.5, [&](int r, int) {
             counts[static_cast<std::size_t>(r)] = count(g_, iso_, options_, plane(r), plane(r + 1));
         });
         const std::vector<RangeOffsets> offsets = scan(counts);
@@ -94,9 +95,12 @@ public:
         m.vertex_count = nv;
         m.triangle_count = nt;
         std::vector<std::vector<SeamValue>> seams(static_cast<std::size_t>(ranges));
-        run_ranges(n, ranges, control, 0.5, 0.5, [&](int r) {
+        // per thread, the cells of its range's triangles, reused from range to range (fresh
+        // memory for every range would cost a page fault per 4 KiB of it)
+        std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(n));
+        run_ranges(n, ranges, control, 0.5, 0.5, [&](int r, int thread) {
             const auto i = static_cast<std::size_t>(r);
-            emit_range(counts[i], offsets[i], m, seams[i]);
+            emit_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);
         });
         for (const std::vector<SeamValue>& seam : seams)
             for (const SeamValue& s : seam) m.values[s.vertex] = std::max(m.values[s.vertex], s.value);
@@ -113,13 +117,14 @@ private:
 
     /// Emits one range into m and finishes its part: values, winding, masked triangles marked
     /// (triangles run cell by cell: each cell's range is computed once).
-    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, std::vector<SeamValue>& seam) const
+    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, Buffer<std::int64_t>& cells,
+                    std::vector<SeamValue>& seam) const
     {
         const auto fv = static_cast<std::size_t>(at.first_vertex);
         const auto ft = static_cast<std::size_t>(at.first_triangle);
         const auto nv = static_cast<std::size_t>(c.vertex_count());
         const auto nt = static_cast<std::size_t>(c.triangle_count());
-        std::vector<std::int64_t> cells(nt); // the range's triangles' cells: 8 bytes a triangle of one range
+        cells.resize(nt); // the range's triangles' cells (emit writes them all)
         MeshSpans out;
         out.positions = m.positions.data() + 3 * fv;
         out.normals = m.normals.data() + 3 * fv;
