@@ -1,7 +1,8 @@
 // cmc33.marching_cubes's extraction: count, scan and emit (cmc33/passes.hpp) over ranges of sample
 // planes, the ranges taken by `threads` threads in turn. Each range, once emitted and while its
-// vertices are in cache, gets its values and its winding. A mask then drops the triangles of
-// masked cells and the vertices no kept triangle uses, in place.
+// vertices are in cache, gets its values, its winding and its coordinates in the array's axis
+// order. A mask then drops the triangles of masked cells and the vertices no kept triangle uses,
+// in place.
 
 #include "drop_in.hpp"
 
@@ -139,22 +140,26 @@ private:
         // those go to `seam`, so that no two ranges write one value.
         float* values = m.values.data();
         std::fill(values + fv, values + fv + nv, 0.0f);
-        Decoder decode(g_.nx(), g_.ny());
-        std::int64_t cell = -1;
-        float range = 0;
-        bool kept = true;
+        // Every triangle computes its cell's range, also when the triangle before it had the same
+        // cell: a branch on "same cell as before" would mispredict about every other triangle,
+        // and the samples are in cache. A dense C-ordered grid stores cell i + nx * (j + ny * k)'s
+        // lowest corner at that offset; other layouts decode the index.
         std::uint32_t* t = m.triangles.data() + 3 * ft;
+        const bool dense = g_.strides[0] == 1 && g_.strides[1] == g_.nx() && g_.strides[2] == g_.nx() * g_.ny();
+        Decoder decode(g_.nx(), g_.ny());
         for (std::size_t f = 0; f < nt; ++f, t += 3) {
-            if (cells[f] != cell) {
-                cell = cells[f];
-                const Index3 corner = decode(cell);
-                kept = !o_.mask || (*o_.mask)(corner[0], corner[1], corner[2]);
-                range = static_cast<float>(cell_range(corner));
+            const T* corner;
+            if (dense && !o_.mask) {
+                corner = g_.data + cells[f];
+            } else {
+                const Index3 at_cell = decode(cells[f]);
+                if (o_.mask && !(*o_.mask)(at_cell[0], at_cell[1], at_cell[2])) {
+                    t[0] = kDropped;
+                    continue;
+                }
+                corner = g_.data + g_.offset(at_cell[0], at_cell[1], at_cell[2]);
             }
-            if (!kept) {
-                t[0] = kDropped;
-                continue;
-            }
+            const float range = static_cast<float>(cell_range(corner));
             for (std::size_t k = 0; k < 3; ++k) {
                 const std::uint32_t v = t[k];
                 if (v - fv < nv) {
@@ -163,7 +168,12 @@ private:
                     seam.push_back({v, range});
                 }
             }
-            if (o_.descent) std::swap(t[1], t[2]);
+            if (!o_.descent) std::swap(t[1], t[2]);
+        }
+        // (x, y, z) to the array's order (z, y, x), while the range's vertices are in cache
+        for (std::size_t v = fv; v < fv + nv; ++v) {
+            std::swap(m.positions[3 * v], m.positions[3 * v + 2]);
+            std::swap(m.normals[3 * v], m.normals[3 * v + 2]);
         }
     }
 
@@ -187,10 +197,9 @@ private:
         std::int64_t nx_, ny_, first_ = std::numeric_limits<std::int64_t>::min() / 2, j_ = 0, k_ = 0;
     };
 
-    /// Largest minus smallest corner sample of the cell with lowest corner c.
-    double cell_range(const Index3& c) const noexcept
+    /// Largest minus smallest corner sample of the cell whose lowest corner is at p.
+    double cell_range(const T* p) const noexcept
     {
-        const T* p = g_.data + g_.offset(c[0], c[1], c[2]);
         const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
         // pairs, then a tree: no branch (std::minmax_element's would mispredict on noisy data)
         const T a0 = p[0], a1 = p[sx], a2 = p[sy], a3 = p[sx + sy];

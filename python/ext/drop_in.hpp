@@ -41,10 +41,13 @@ struct DropInOptions {
     int threads = 0;                ///< 0: all cores; the arrays are the same for every count
 };
 
-/// The mesh with normals (as extract() makes it, winding reversed for `descent`), and per vertex the
-/// largest value range (largest minus smallest corner sample) of the kept cells whose triangles
-/// use it: what scikit-image returns as `values`. Stops between ranges of sample planes once
-/// control says so (Error{cancelled}); reports the fraction done through it.
+/// The mesh of extract() with normals, its positions and normals in the array's axis order
+/// (z, y, x: columns 0 and 2 swapped), and per vertex the largest value range (largest minus
+/// smallest corner sample) of the kept cells whose triangles use it: what scikit-image returns
+/// as `values`. Swapping two coordinates mirrors the mesh, so extract()'s triangles, which wind
+/// counter-clockwise around the normals, wind clockwise in the array's order: scikit-image's
+/// 'descent'; 'ascent' reverses them. Stops between ranges of sample planes once control says so
+/// (Error{cancelled}); reports the fraction done through it.
 /// @throws Error from the passes; Error{too_large} beyond 32-bit vertex ids
 DropInMesh extract_drop_in(const Samples& samples, const Frame& frame, double iso, const DropInOptions& options,
                            Control& control);

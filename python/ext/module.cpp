@@ -200,15 +200,14 @@ PyMesh extract_py(const py::array& volume, double iso, const Vec3& spacing, cons
     return PyMesh{std::move(mesh), stats, normals};
 }
 
-/// marching_cubes' four arrays. `spacing` is in the array's axis order and so are the vertices:
-/// the frame's direction maps the library's x (the last axis) to the third coordinate.
+/// marching_cubes' four arrays. `spacing` is in the array's axis order and so are the vertices
+/// (extract_drop_in swaps x and z once a range is written).
 py::tuple marching_cubes_py(const py::array& volume, double level, const Vec3& spacing, const std::string& method,
                             bool descent, const py::object& mask_cells, int threads, const py::object& progress)
 {
     const Samples s = samples_of(volume);
     Frame frame;
     frame.spacing = {spacing[2], spacing[1], spacing[0]};
-    frame.direction = {{{0, 0, 1}, {0, 1, 0}, {1, 0, 0}}};
     DropInOptions options;
     options.method = parse_method(method);
     options.descent = descent;
