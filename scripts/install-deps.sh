@@ -1,11 +1,14 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
 # Idempotent and quiet when everything is present.
-# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--web]
-#   --bench  also the peers the benchmark compares against (VTK, scikit-image)
-#   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
-#   --mpi    also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
-#   --web    also emscripten, node and npm, and chromium for the page's browser tests (web/)
+# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--python] [--web]
+#   --bench   also the peers the benchmark compares against (VTK, scikit-image)
+#   --fuzz    also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --mpi     also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
+#   --python  also what the Python package needs to build, test and show its examples (python/,
+#             scripts/test-python.sh): pybind11, numpy, setuptools, venv, build, pytest, and the
+#             peers its tests and README use (scikit-image, meshio, VTK)
+#   --web     also emscripten, node and npm, and chromium for the page's browser tests (web/)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
@@ -24,7 +27,10 @@ for flag in "$@"; do
         command -v node >/dev/null || packages+=(nodejs)
         command -v npm >/dev/null || packages+=(npm)
         ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi or --web" >&2; exit 2 ;;
+    --python) packages+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-wheel
+                         python3-venv python3-pip python3-build python3-pytest python3-skimage python3-meshio
+                         python3-vtk9) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --python or --web" >&2; exit 2 ;;
     esac
 done
 

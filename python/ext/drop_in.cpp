@@ -1,0 +1,268 @@
+// cmc33.marching_cubes's extraction: count, scan and emit (cmc33/passes.hpp) over ranges of sample
+// planes, the ranges taken by `threads` threads in turn. Each range, once emitted and while its
+// vertices are in cache, gets its values, its winding and its coordinates in the array's axis
+// order. A mask then drops the triangles of masked cells and the vertices no kept triangle uses,
+// in place.
+
+#include "drop_in.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "cmc33/passes.hpp"
+
+namespace cmc33::python {
+namespace {
+
+// Ranges of about 16 sample planes: the stop flag is read between ranges, so a 512^2 plane range
+// ends a Ctrl-C wait in tens of milliseconds, while the planes a range reads twice (its ends) stay
+// a small share. At least 4 ranges per thread, as extract() does, for uneven surfaces.
+constexpr std::int64_t kPlanesPerRange = 16;
+constexpr std::int64_t kMinRanges = 32;
+constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
+
+/// Runs job(r, t) for r in [0, ranges) on n threads t = 0 .. n - 1 (0 the calling one), each
+/// range taken by whichever thread is free. No range starts once control says stop or a job has
+/// thrown; then the error of the lowest range that threw is rethrown, or Error{cancelled}.
+/// Reports the fraction from + share * (ranges done / ranges) to control.
+void run_ranges(int n, int ranges, Control& control, double from, double share,
+                const std::function<void(int range, int thread)>& job)
+{
+    std::atomic<int> next{0}, done{0};
+    std::atomic<bool> failed{false};
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ranges));
+    const auto work = [&](int thread) {
+        for (int r = next.fetch_add(1); r < ranges; r = next.fetch_add(1)) {
+            if (failed.load(std::memory_order_relaxed) || control.stopped()) return;
+            try {
+                job(r, thread);
+            } catch (...) {
+                errors[static_cast<std::size_t>(r)] = std::current_exception();
+                failed.store(true, std::memory_order_relaxed);
+            }
+            control.keep_going(from + share * (done.fetch_add(1) + 1) / ranges);
+        }
+    };
+    {
+        std::vector<std::jthread> pool;
+        for (int t = 1; t < n; ++t) pool.emplace_back(work, t);
+        work(0);
+    }
+    for (const std::exception_ptr& e : errors) {
+        if (e) std::rethrow_exception(e);
+    }
+    if (control.stopped()) throw Error(Status::cancelled, "extraction cancelled by the progress callback");
+}
+
+template <class T> class DropIn {
+public:
+    DropIn(const GridView<T>& g, double iso, const DropInOptions& o) : g_(g), iso_(iso), o_(o)
+    {
+        options_.method = o.method;
+        options_.normals = true;
+    }
+
+    DropInMesh run(Control& control)
+    {
+        const std::int64_t nz = g_.nz();
+        const int n = static_cast<int>(std::clamp<std::int64_t>(resolve_threads(o_.threads), 1, nz));
+        const int ranges = static_cast<int>(
+            std::min(nz, std::clamp<std::int64_t>(nz / kPlanesPerRange, n, std::max<std::int64_t>(4 * n, kMinRanges))));
+        const auto plane = [&](int r) { return nz * r / ranges; };
+
+        std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
+        run_ranges(n, ranges, control, 0, 0.5, [&](int r, int) {
+            counts[static_cast<std::size_t>(r)] = count(g_, iso_, options_, plane(r), plane(r + 1));
+        });
+        const std::vector<RangeOffsets> offsets = scan(counts);
+        const std::int64_t nv = offsets.back().first_vertex + counts.back().vertex_count();
+        const std::int64_t nt = offsets.back().first_triangle + counts.back().triangle_count();
+        if (nv >= static_cast<std::int64_t>(kDropped)) {
+            throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
+                                               " vertices, more than 32-bit indices can address");
+        }
+        DropInMesh m;
+        m.positions.resize(static_cast<std::size_t>(nv) * 3);
+        m.normals.resize(static_cast<std::size_t>(nv) * 3);
+        m.values.resize(static_cast<std::size_t>(nv));
+        m.triangles.resize(static_cast<std::size_t>(nt) * 3);
+        m.vertex_count = nv;
+        m.triangle_count = nt;
+        std::vector<std::vector<SeamValue>> seams(static_cast<std::size_t>(ranges));
+        // per thread, the cells of its range's triangles, reused from range to range (fresh
+        // memory for every range would cost a page fault per 4 KiB of it)
+        std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(n));
+        run_ranges(n, ranges, control, 0.5, 0.5, [&](int r, int thread) {
+            const auto i = static_cast<std::size_t>(r);
+            emit_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);
+        });
+        for (const std::vector<SeamValue>& seam : seams)
+            for (const SeamValue& s : seam) m.values[s.vertex] = std::max(m.values[s.vertex], s.value);
+        if (o_.mask) compact(m);
+        return m;
+    }
+
+private:
+    /// A value for a vertex of the next range, set once every range is done.
+    struct SeamValue {
+        std::uint32_t vertex;
+        float value;
+    };
+
+    /// Emits one range into m and finishes its part: values, winding, masked triangles marked
+    /// (triangles run cell by cell: each cell's range is computed once).
+    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, Buffer<std::int64_t>& cells,
+                    std::vector<SeamValue>& seam) const
+    {
+        const auto fv = static_cast<std::size_t>(at.first_vertex);
+        const auto ft = static_cast<std::size_t>(at.first_triangle);
+        const auto nv = static_cast<std::size_t>(c.vertex_count());
+        const auto nt = static_cast<std::size_t>(c.triangle_count());
+        cells.resize(nt); // the range's triangles' cells (emit writes them all)
+        MeshSpans out;
+        out.positions = m.positions.data() + 3 * fv;
+        out.normals = m.normals.data() + 3 * fv;
+        out.triangles = m.triangles.data() + 3 * ft;
+        out.triangle_cells = cells.data();
+        out.first_vertex = at.first_vertex;
+        out.first_triangle = at.first_triangle;
+        emit(g_, iso_, options_, c, at, out);
+
+        // scikit-image's values: per vertex, the largest range among the kept cells whose
+        // triangles use it. This range's triangles also use the next range's first plane:
+        // those go to `seam`, so that no two ranges write one value.
+        float* values = m.values.data();
+        std::fill(values + fv, values + fv + nv, 0.0f);
+        // Every triangle computes its cell's range, also when the triangle before it had the same
+        // cell: a branch on "same cell as before" would mispredict about every other triangle,
+        // and the samples are in cache. A dense C-ordered grid stores cell i + nx * (j + ny * k)'s
+        // lowest corner at that offset; other layouts decode the index.
+        std::uint32_t* t = m.triangles.data() + 3 * ft;
+        const bool dense = g_.strides[0] == 1 && g_.strides[1] == g_.nx() && g_.strides[2] == g_.nx() * g_.ny();
+        Decoder decode(g_.nx(), g_.ny());
+        for (std::size_t f = 0; f < nt; ++f, t += 3) {
+            const T* corner;
+            if (dense && !o_.mask) {
+                corner = g_.data + cells[f];
+            } else {
+                const Index3 at_cell = decode(cells[f]);
+                if (o_.mask && !(*o_.mask)(at_cell[0], at_cell[1], at_cell[2])) {
+                    t[0] = kDropped;
+                    continue;
+                }
+                corner = g_.data + g_.offset(at_cell[0], at_cell[1], at_cell[2]);
+            }
+            const float range = static_cast<float>(cell_range(corner));
+            for (std::size_t k = 0; k < 3; ++k) {
+                const std::uint32_t v = t[k];
+                if (v - fv < nv) {
+                    values[v] = std::max(values[v], range);
+                } else {
+                    seam.push_back({v, range});
+                }
+            }
+            if (!o_.descent) std::swap(t[1], t[2]);
+        }
+        // (x, y, z) to the array's order (z, y, x), while the range's vertices are in cache
+        for (std::size_t v = fv; v < fv + nv; ++v) {
+            std::swap(m.positions[3 * v], m.positions[3 * v + 2]);
+            std::swap(m.normals[3 * v], m.normals[3 * v + 2]);
+        }
+    }
+
+    /// (i, j, k) of a cell index i + nx * (j + ny * k). Triangles come cell row by cell row, so
+    /// the row of the previous index is kept and the divisions are done once per row.
+    class Decoder {
+    public:
+        Decoder(std::int64_t nx, std::int64_t ny) noexcept : nx_(nx), ny_(ny) {}
+        Index3 operator()(std::int64_t index) noexcept
+        {
+            if (index < first_ || index >= first_ + nx_) {
+                const std::int64_t row = index / nx_;
+                first_ = row * nx_;
+                j_ = row % ny_;
+                k_ = row / ny_;
+            }
+            return {index - first_, j_, k_};
+        }
+
+    private:
+        std::int64_t nx_, ny_, first_ = std::numeric_limits<std::int64_t>::min() / 2, j_ = 0, k_ = 0;
+    };
+
+    /// Largest minus smallest corner sample of the cell whose lowest corner is at p.
+    double cell_range(const T* p) const noexcept
+    {
+        const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
+        // pairs, then a tree: no branch (std::minmax_element's would mispredict on noisy data)
+        const T a0 = p[0], a1 = p[sx], a2 = p[sy], a3 = p[sx + sy];
+        const T a4 = p[sz], a5 = p[sx + sz], a6 = p[sy + sz], a7 = p[sx + sy + sz];
+        const T lo = std::min(std::min(std::min(a0, a1), std::min(a2, a3)), std::min(std::min(a4, a5), std::min(a6, a7)));
+        const T hi = std::max(std::max(std::max(a0, a1), std::max(a2, a3)), std::max(std::max(a4, a5), std::max(a6, a7)));
+        return static_cast<double>(hi) - static_cast<double>(lo);
+    }
+
+    /// Drops the marked triangles and the vertices no kept triangle uses, keeping the order of
+    /// both, in place (a vertex only moves to a lower id).
+    static void compact(DropInMesh& m)
+    {
+        const auto nv = static_cast<std::size_t>(m.vertex_count);
+        const auto nt = static_cast<std::size_t>(m.triangle_count);
+        std::uint32_t* t = m.triangles.data();
+        std::vector<std::uint32_t> id(nv, kDropped);
+        for (std::size_t f = 0; f < nt; ++f) {
+            if (t[3 * f] == kDropped) continue;
+            for (std::size_t c = 0; c < 3; ++c) id[t[3 * f + c]] = 0;
+        }
+        std::uint32_t kept_vertices = 0;
+        for (std::size_t v = 0; v < nv; ++v) {
+            if (id[v] == kDropped) continue;
+            const std::size_t to = kept_vertices;
+            id[v] = kept_vertices++;
+            for (std::size_t c = 0; c < 3; ++c) {
+                m.positions[3 * to + c] = m.positions[3 * v + c];
+                m.normals[3 * to + c] = m.normals[3 * v + c];
+            }
+            m.values[to] = m.values[v];
+        }
+        std::size_t kept_triangles = 0;
+        for (std::size_t f = 0; f < nt; ++f) {
+            if (t[3 * f] == kDropped) continue;
+            for (std::size_t c = 0; c < 3; ++c) t[3 * kept_triangles + c] = id[t[3 * f + c]];
+            ++kept_triangles;
+        }
+        m.vertex_count = kept_vertices;
+        m.triangle_count = static_cast<std::int64_t>(kept_triangles);
+    }
+
+    const GridView<T> g_;
+    const double iso_;
+    const DropInOptions o_;
+    ExtractOptions options_;
+};
+
+} // namespace
+
+DropInMesh extract_drop_in(const Samples& samples, const Frame& frame, double iso, const DropInOptions& options,
+                           Control& control)
+{
+    if (options.mask) {
+        for (std::size_t a = 0; a < 3; ++a) {
+            if (options.mask->dims[a] != samples.dims[a] - 1) {
+                throw Error(Status::invalid_argument, "the cell mask has " + std::to_string(options.mask->dims[a]) +
+                                                          " cells along " + "xyz"[a] + "; expected " +
+                                                          std::to_string(samples.dims[a] - 1));
+            }
+        }
+    }
+    return visit(samples, frame, [&](const auto& grid) { return DropIn(grid, iso, options).run(control); });
+}
+
+} // namespace cmc33::python
