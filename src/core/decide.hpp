@@ -143,6 +143,18 @@ inline bool face_joined_filtered(const double* w, bool a_above, int f, bool& unc
     return (a_above & !negative) | (!a_above & !positive); // sign rule: a zero saddle is above
 }
 
+/// The double x (an integer for R = Int128) as an R. Int128 takes the one-instruction conversion
+/// through 64 bits where x fits (the values of the integer path always do), not libgcc's.
+template <class R> R exact(double x)
+{
+#if CMC33_HAS_INT128
+    if constexpr (std::is_same_v<R, Int128>) {
+        if (std::abs(x) < 0x1p62) return static_cast<Int128>(static_cast<long long>(x));
+    }
+#endif
+    return R(x);
+}
+
 /// A number x + eps * y with eps > 0 infinitesimal, compared lexicographically. The interior tests
 /// run on these with every value v - iso given as (v - iso) + eps: that is the level set at
 /// iso - eps, exactly the sign rule, so exact ties (integer data at an integer isovalue) are decided
@@ -154,7 +166,7 @@ template <class R> struct EpsT {
     friend EpsT operator+(const EpsT& a, const EpsT& b) { return {a.x + b.x, a.y + b.y}; }
     friend EpsT operator-(const EpsT& a, const EpsT& b) { return {a.x - b.x, a.y - b.y}; }
     friend EpsT operator*(const EpsT& a, const EpsT& b) { return {a.x * b.x, a.x * b.y + a.y * b.x}; }
-    friend EpsT operator*(double k, const EpsT& a) { return {R(k) * a.x, R(k) * a.y}; }
+    friend EpsT operator*(double k, const EpsT& a) { return {exact<R>(k) * a.x, exact<R>(k) * a.y}; }
     int sign() const
     {
         const int s = sgn(x);
@@ -358,7 +370,7 @@ template <class R, class E = EpsT<R>>
 Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
 {
     R w[8];
-    for (int q = 0; q < 8; ++q) w[q] = R(raw[q]) - R(iso);
+    for (int q = 0; q < 8; ++q) w[q] = exact<R>(raw[q]) - exact<R>(iso);
     const unsigned amb = kAmbiguousFaces[config];
     unsigned bits = 0;
     if (method != Method::mc) {
