@@ -351,7 +351,7 @@ public:
         : g_(g), iso_(iso), threshold_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
           words_((nx_ + 63) / 64), sample_valid_(valid_words(words_, nx_)), x_valid_(valid_words(words_, nx_ - 1)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
-          delta_(min_crossing(g, m_))
+          delta_(min_crossing(g, m_)), variants_(detail::tables_of(opt.method))
     {
         for (std::size_t a = 0; a < 3; ++a) {
             step_[a] = diagonal_ ? m_[a][a] : 1.0;
@@ -359,7 +359,7 @@ public:
         }
         if (!diagonal_) normal_map_ = inverse_transpose(m_);
         for (unsigned code = 0; code < 256; ++code) {
-            const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
+            const detail::Variant& first = variants_[detail::kVariantOffset[code]];
             const bool tested = opt.method != Method::mc &&
                                 (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
             fixed_tiling_[code] = tested ? nullptr : &first.tilings[0];
@@ -630,7 +630,7 @@ private:
         for (int c = 0; c < 8; ++c) {
             raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
-        const detail::Decision d = detail::decide(raw, iso_, code, method_);
+        const detail::Decision d = detail::decide(raw, iso_, code, method_, variants_);
         subcase = d.subcase;
         decision = static_cast<std::uint8_t>(d.joined << 2 | static_cast<unsigned>(d.tiling));
         return d.variant->tilings[d.tiling];
@@ -640,15 +640,16 @@ private:
     static constexpr int kShortTiling = 4;
 
     /// kTriangleCodes followed by 3 * kShortTiling zeros, so that a short tiling's fixed-size copy
-    /// stays inside the table.
+    /// stays inside the table (both table sets index it).
     static const std::vector<std::uint8_t>& padded_codes()
     {
         static const std::vector<std::uint8_t> table = [] {
             std::size_t n = 0;
-            for (unsigned v = 0; v < detail::kVariantOffset[256]; ++v)
-                for (const detail::Tiling& t : detail::kVariants[v].tilings) {
-                    n = std::max<std::size_t>(n, (static_cast<std::size_t>(t.first_triangle) + t.triangle_count) * 3);
-                }
+            for (const detail::Variant* set : {detail::kVariants, detail::kLegacyVariants})
+                for (unsigned v = 0; v < detail::kVariantOffset[256]; ++v)
+                    for (const detail::Tiling& t : set[v].tilings) {
+                        n = std::max<std::size_t>(n, (static_cast<std::size_t>(t.first_triangle) + t.triangle_count) * 3);
+                    }
             std::vector<std::uint8_t> codes(detail::kTriangleCodes, detail::kTriangleCodes + n);
             codes.resize(n + 3 * kShortTiling, 0);
             return codes;
@@ -658,12 +659,12 @@ private:
 
     /// The tiling a decision byte of decide_cell() names for case code `code`; null when the byte
     /// cannot be one of that code's (the samples changed between count and emit).
-    static const detail::Tiling* replay(unsigned code, std::uint8_t decision)
+    const detail::Tiling* replay(unsigned code, std::uint8_t decision) const
     {
         const unsigned joined = decision >> 2u, tiling = decision & 3u;
         const unsigned variants = detail::kVariantOffset[code + 1] - detail::kVariantOffset[code];
         if (joined >= variants || tiling > 2) return nullptr;
-        return &detail::kVariants[detail::kVariantOffset[code] + joined].tilings[tiling];
+        return &variants_[detail::kVariantOffset[code] + joined].tilings[tiling];
     }
 
     /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
@@ -1083,6 +1084,9 @@ private:
     double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
+    /// The method's table set (detail::tables_of): chosen once here, so the passes' loops read one
+    /// pointer and nothing in them depends on the method
+    const detail::Variant* variants_;
     /// Per case code: its one tiling, or null when the method decides the cell (face or interior
     /// tests); and its subcase then.
     std::array<const detail::Tiling*, 256> fixed_tiling_{};

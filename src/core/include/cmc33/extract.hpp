@@ -1,8 +1,9 @@
 #pragma once
 /// @file extract.hpp
 /// The isosurface extractor: Marching Cubes 33 with the corrections of Custodio, Etiene, Pesco and
-/// Silva 2013 (method `cmc33`), and for comparison the earlier MC33 (`mc33-lewiner`) and classic
-/// Marching Cubes (`mc`). One code path; only the decision policy differs.
+/// Silva 2013 (method `cmc33`), and for comparison the methods that paper compares: Chernyaev's
+/// MC33 (`chernyaev`), Lewiner et al.'s (`mc33-lewiner`) and classic Marching Cubes (`mc`). One code path; the decision policy and the table set are
+/// chosen per call.
 
 #include <array>
 #include <cstdint>
@@ -15,13 +16,21 @@
 
 namespace cmc33 {
 
+/// The methods of Custodio et al. 2013 (C13). Two table sets (src/tables/mc33_tables.hpp): embedded
+/// tubes (cmc33, mc) and Chernyaev's tubes, which lie in a cell face where they cross an ambiguous
+/// one, so that two neighbouring tunnels through one face give non-manifold edges (C13 Sec. 5.2;
+/// chernyaev, mc33-lewiner).
 enum class Method {
-    cmc33,        ///< default: topologically correct and manifold
-    mc33_lewiner, ///< MC33 with the flaws the 2013 paper describes (t_alt, case 10/12 branch, 13.5)
+    cmc33,        ///< default: C13's decisions, embedded tubes: topologically correct, manifold, embedded
+    mc33_lewiner, ///< Lewiner et al. 2003: t_alt for cases 6, 7, 12, 13 (C13 Issue III), no joined
+                  ///< branch of cases 10 and 12 (Issue IV), 13.5 by condition (iii) (Issue I); Chernyaev's tubes
     mc,           ///< classic Marching Cubes: one triangulation per sign configuration
+    chernyaev,    ///< Chernyaev 1995: t_max and his three conditions everywhere, 13.5 included (C13
+                  ///< Issue I), Algorithm 2 complete; his tubes (Issue II)
 };
 
-CMC33_CORE_EXPORT std::string_view method_name(Method method) noexcept; ///< "cmc33", "mc33-lewiner", "mc"
+/// "cmc33", "mc33-lewiner", "mc", "chernyaev"
+CMC33_CORE_EXPORT std::string_view method_name(Method method) noexcept;
 /// @throws Error{invalid_argument} naming the accepted names.
 CMC33_CORE_EXPORT Method parse_method(std::string_view name);
 
@@ -55,6 +64,7 @@ struct ExtractStats {
 };
 
 /// Extracts S = {x : f(x) = iso}, f the trilinear interpolant of the samples.
+
 ///
 /// Sign rule: a sample (or face or interior saddle) equal to iso counts as above it.
 /// One vertex per crossed grid edge, shared by every cell around that edge; cells whose subcase
