@@ -318,7 +318,8 @@ inline double t_alt(const double* v, int edge)
 /// Algorithm 2 of Custodio et al. 2013 (Sec. 6.4), generalised to every variant with an interior
 /// ambiguity (cases 4, 6, 7, 10, 12 and 13.5): the face tests have chosen `var`; the interior test
 /// decides whether the tunnel is there, and for 13.5 which way it faces (tiling 1: the above
-/// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 every branch is tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces
+/// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 (and cmc33-paper)
+/// every branch is tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces
 /// joined); the legacy policy of mc33-lewiner is read from the variant (Variant::lewiner);
 /// chernyaev tests every branch with t_max, and 13.5 with his three conditions (chernyaev_13_5),
 /// its tunnel always facing the above corner: Chernyaev does not orient it (Sec. 5.1.1).
@@ -420,10 +421,10 @@ inline Decision decide(const double* raw, double iso, unsigned config, Method me
 }
 
 /// The table set of a method: Chernyaev's tubes for the methods that reproduce Custodio et al.
-/// 2013 (chernyaev, mc33-lewiner), embedded tubes for cmc33 and mc.
+/// 2013 (chernyaev, mc33-lewiner, cmc33-paper), embedded tubes for cmc33 and mc.
 inline const Variant* tables_of(Method method)
 {
-    const bool legacy = method == Method::chernyaev || method == Method::mc33_lewiner;
+    const bool legacy = method == Method::chernyaev || method == Method::mc33_lewiner || method == Method::cmc33_paper;
     return legacy ? kLegacyVariants : kVariants;
 }
 

@@ -45,6 +45,7 @@
 #include "parallel.hpp"
 #include "placement.hpp"
 #include "portability.hpp"
+#include "refine.hpp"
 #include "mc33_tables.hpp"
 #include "thread_pool.hpp"
 
@@ -1144,9 +1145,20 @@ std::string range_text(std::int64_t k0, std::int64_t k1)
 
 } // namespace
 
+/// The passes run on the grid as it is; cmc33-paper may refine it first.
+static void check_passes_method(const ExtractOptions& options, const char* pass)
+{
+    if (options.method == Method::cmc33_paper) {
+        throw Error(Status::invalid_argument, std::string(pass) +
+                                                  ": method cmc33-paper refines the grid first (Custodio et al. 2013, "
+                                                  "Sec. 6.2), which the passes cannot; use extract(), or another method");
+    }
+}
+
 template <class T>
 RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1)
 {
+    check_passes_method(options, "count");
     check_grid(grid, iso);
     if (!(0 <= k0 && k0 < k1 && k1 <= grid.nz())) {
         throw Error(Status::invalid_argument, "count: sample planes " + range_text(k0, k1) + "; expected 0 <= k0 < k1 <= " +
@@ -1181,6 +1193,7 @@ template <class T>
 void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out)
 {
+    check_passes_method(options, "emit");
     check_grid(grid, iso);
     if (counts.k1() > grid.nz() || counts.k0() >= counts.k1() || !RangeExtractor<T>::same_rows(counts, grid)) {
         throw Error(Status::invalid_argument, "emit: the counts of planes " + range_text(counts.k0(), counts.k1()) +
@@ -1192,6 +1205,17 @@ void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, co
 }
 
 template <class T> Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
+{
+    if (options.method == Method::cmc33_paper) {
+        check_grid(grid, iso);
+        scan_samples(grid, 0, grid.nz() - 1); // refine.cpp decides cells before any pass has read them
+        return detail::extract_refined(grid, iso, options, stats);
+    }
+    return detail::extract_passes(grid, iso, options, stats);
+}
+
+template <class T>
+Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
 {
     check_grid(grid, iso);
     const std::int64_t nz = grid.nz();
@@ -1253,6 +1277,7 @@ Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, Ex
 
 #define CMC33_INSTANTIATE(T)                                                                                    \
     template Mesh extract<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);                       \
+    template Mesh detail::extract_passes<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);        \
     template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
     template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
                           const MeshSpans&);

@@ -369,15 +369,17 @@ def legacy_tube(config, joined, ls, pair):
     strip walks U forward and V backward (so that both loops are used in their own direction):
     every triangle is (u_i, u_i+1, v_j) or (v_j-1, v_j, u_i). Across each band of legacy_bands()
     the strip must pass through the rungs (a, d) and (b, c), so the band's quadrilateral
-    a, b, c, d lies in the face. Among such strips the one with the shortest rungs (between edge
-    midpoints) is taken."""
+    a, b, c, d lies in the face; no other rung lies in a face. Among such strips the one with the
+    shortest rungs (between edge midpoints) is taken."""
     U = [e for e, _ in ls[pair[0]]]
     V = [e for e, _ in ls[pair[1]]]
     m, n = len(U), len(V)
-    forced = []
+    forced, in_band = [], set()
     for _, (a, b), (c, d) in legacy_bands(config, joined, ls, pair):
         forced += [(a, d), (b, c)]
-    rung = lambda u, v: dist(edge_mid(u), edge_mid(v))
+        in_band |= {(a, d), (b, c), (b, d)}  # the band's sides and one diagonal
+    # no other rung may lie in a face: it would cross the band's diagonal or a face's corner region
+    rung = lambda u, v: dist(edge_mid(u), edge_mid(v)) if (u, v) in in_band or not share_face(u, v) else float("inf")
     best = None
     for s, t in itertools.product(range(m), range(n)):
         u = lambda i: U[(s + i) % m]
@@ -408,7 +410,7 @@ def strip(u, v, m, n, need, rung):
     cost[0][0] = rung(u(0), v(0))
     for i in range(m + 1):
         for j in range(n + 1):
-            if (i, j) == (0, 0) or not ok(i, j):
+            if (i, j) == (0, 0) or not ok(i, j) or rung(u(i), v(j)) == inf:
                 continue
             here = rung(u(i), v(j))
             for pi, pj, step in ((i - 1, j, "u"), (i, j - 1, "v")):
