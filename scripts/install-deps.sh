@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
-# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz]
+# Idempotent and quiet when everything is present. Usage: scripts/install-deps.sh [--bench] [--fuzz] [--paper]
 #   --bench  also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz   also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
+#   --paper  also what scripts/paper/all.sh needs for the paper's figures (matplotlib, VTK, and
+#            xvfb: Debian's VTK renders off screen only through an X server)
 set -euo pipefail
 
 # libcgal-dev is test-only: tests/topology/test_geometry_cgal.cpp checks mesh_geometry() against
@@ -13,7 +15,8 @@ for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench or --fuzz" >&2; exit 2 ;;
+    --paper) packages+=(python3-matplotlib python3-numpy python3-vtk9 xvfb xauth) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz or --paper" >&2; exit 2 ;;
     esac
 done
 
