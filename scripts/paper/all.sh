@@ -3,7 +3,7 @@
 # docs/figures/fig8_shared_face.*, fig12_render.*, fig13_components.*, fig14_nonmanifold.*.
 # Installs what is missing (scripts/install-deps.sh --paper), builds the cmc33 CLI (Release) and
 # runs each script with Debian's Python; each prints what it measured. Needs the volumes of
-# ../shared/data/volumes (or CMC33_VOLUMES). About 10 minutes on 2 cores.
+# ../shared/data/volumes (or CMC33_VOLUMES). About 3 minutes on 2 cores once built.
 # Usage: scripts/paper/all.sh        (CI does not run it: it runs the tests only)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
