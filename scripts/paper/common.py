@@ -136,10 +136,13 @@ def shared_faces(positions, edges, spacing):
 
 
 def save(fig, name):
-    """Writes docs/figures/NAME.svg and .png; returns their paths."""
+    """Writes docs/figures/NAME.svg and .png; returns their paths. No date and fixed ids in the
+    SVG, so the same data give the same files."""
+    import matplotlib
+    matplotlib.rcParams["svg.hashsalt"] = "cmc33"
     os.makedirs(FIGURES, exist_ok=True)
     paths = [os.path.join(FIGURES, name + ext) for ext in (".svg", ".png")]
-    fig.savefig(paths[0], bbox_inches="tight")
+    fig.savefig(paths[0], bbox_inches="tight", metadata={"Date": None})
     fig.savefig(paths[1], bbox_inches="tight", dpi=130)
     return paths
 
