@@ -92,8 +92,9 @@ TEST(Decide, FilteredDecisionsAreTheExactOnes)
             double raw[8];
             for (double& x : raw) x = iso + any(rng);
             raw[p[0]] = iso + u(rng), raw[p[2]] = iso + u(rng), raw[p[3]] = iso - u(rng);
-            const long double l_iso = iso;
-            double b = static_cast<double>(l_iso + (raw[p[0]] - l_iso) * (raw[p[2]] - l_iso) / (raw[p[3]] - l_iso));
+            const auto l_iso = static_cast<long double>(iso);
+            const auto l = [&](int q) { return static_cast<long double>(raw[p[static_cast<std::size_t>(q)]]); };
+            double b = static_cast<double>(l_iso + (l(0) - l_iso) * (l(2) - l_iso) / (l(3) - l_iso));
             for (int step = static_cast<int>(rng() % 9); step > 0; --step) b = std::nextafter(b, rng() % 2 ? 1.0 : -1.0);
             raw[p[1]] = b;
             cells += compare([&, q = 0](auto&) mutable { return raw[q++]; }, iso, 1, 0, "near-singular face");
