@@ -138,7 +138,7 @@ void print_interior(const InteriorReport& r, Method method)
               << "  Lewiner et al.: sweep along " << kAxis[r.lewiner_axis] << " from corner "
               << corner_text(r.lewiner_corner) << ", edge " << r.lewiner_edge << ": t_alt = " << maybe(r.t_alt)
               << ", F(t_alt) = " << maybe(r.f_t_alt) << '\n';
-    if (r.test == "13.5" && method == Method::cmc33) { // mc33-lewiner does not compute them
+    if (r.test == "13.5" && (method == Method::cmc33 || method == Method::cmc33_paper)) { // Algorithm 1's numbers
         std::cout << "  slice saddles: x_c(t1) = (" << maybe(r.saddle1[0]) << ", " << maybe(r.saddle1[1])
                   << "), x_c(t2) = (" << maybe(r.saddle2[0]) << ", " << maybe(r.saddle2[1]) << ")\n";
     }
@@ -227,7 +227,7 @@ void add_cell(CLI::App& app)
         ->type_name("V")
         ->check(number_check());
     cmd->add_option("-i,--iso", args->iso, "Isovalue (default 0)")->check(number_check());
-    cmd->add_option("--method", args->method, "cmc33 (default), mc33-lewiner or mc")
+    cmd->add_option("--method", args->method, "cmc33 (default), cmc33-paper, chernyaev, mc33-lewiner or mc")
         ->type_name("NAME")
         ->check(method_validator());
     cmd->add_flag("--json", args->json, "Print one JSON object");

@@ -105,7 +105,7 @@ void add_extract(CLI::App& app)
     cmd->add_option("-o,--output", args->output, "Write the mesh: .ply .obj .stl .off (by extension)")
         ->type_name("OUT")
         ->check(non_empty("a mesh file name"));
-    cmd->add_option("--method", args->method, "cmc33 (default), mc33-lewiner or mc")
+    cmd->add_option("--method", args->method, "cmc33 (default), cmc33-paper, chernyaev, mc33-lewiner or mc")
         ->type_name("NAME")
         ->check(method_validator());
     cmd->add_flag("--normals", args->normals, "Per-vertex normals from the field's gradient (.ply and .obj only)");
@@ -140,7 +140,8 @@ void add_extract(CLI::App& app)
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT, extracts the triangle mesh of the isosurface at ISO with Marching Cubes 33\n"
-        "(method cmc33: topologically correct and manifold; mc33-lewiner and mc for comparison),\n"
+        "(method cmc33: topologically correct, manifold and embedded; cmc33-paper, chernyaev,\n"
+        "mc33-lewiner and mc reproduce Custodio et al. 2013's comparison: docs/paper.md),\n"
         "and prints one summary line: vertices, triangles, the time of the extraction alone (no\n"
         "reading or writing), and the mesh's topology (Euler characteristic, components, boundary\n"
         "and non-manifold edges). With -o the mesh is written in the format of OUT's extension.\n"

@@ -146,7 +146,7 @@ CLI::Validator method_validator()
                 return e.what();
             }
         },
-        "cmc33|mc33-lewiner|mc", "method");
+        "cmc33|cmc33-paper|chernyaev|mc33-lewiner|mc", "method");
 }
 
 CLI::Validator number_check()

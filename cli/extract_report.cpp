@@ -33,7 +33,9 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
                  {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
                  {"topology", !args.no_topology ? topology_json(r.topology) : Json(nullptr)},
                  {"geometry", geometry},
-                 {"subcases", subcases}};
+                 {"subcases", subcases},
+                 // cmc33-paper: planes the Sec. 6.2 refinement added (0: none needed); null for the others
+                 {"refinement_planes", r.method == Method::cmc33_paper ? Json(r.stats.refinement_planes) : Json(nullptr)}};
         for (auto it = r.extra.begin(); it != r.extra.end(); ++it) out[it.key()] = it.value();
         print_json(out);
         return;

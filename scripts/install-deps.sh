@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
 # Idempotent and quiet when everything is present.
-# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--python] [--web]
+# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--paper] [--python] [--web]
 #   --bench   also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz    also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
 #   --mpi     also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
+#   --paper   also what scripts/paper/all.sh needs for the paper's figures (matplotlib, VTK, and
+#             xvfb: Debian's VTK renders off screen only through an X server)
 #   --python  also what the Python package needs to build, test and show its examples (python/,
 #             scripts/test-python.sh): pybind11, numpy, setuptools, venv, build, pytest, and the
 #             peers its tests and README use (scikit-image, meshio, VTK)
@@ -30,7 +32,8 @@ for flag in "$@"; do
     --python) packages+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-wheel
                          python3-venv python3-pip python3-build python3-pytest python3-skimage python3-meshio
                          python3-vtk9) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --python or --web" >&2; exit 2 ;;
+    --paper) packages+=(python3-matplotlib python3-numpy python3-vtk9 xvfb xauth) ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --paper, --python or --web" >&2; exit 2 ;;
     esac
 done
 

@@ -15,4 +15,4 @@ export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$PWD/t
 # Extract.* holds the thread-count identity test, Passes.* the progress, cancel and executor tests; the exhaustive table and subcase suites are
 # single-threaded and left out, as are the stress runs of `cmc33 verify` (label slow).
 ctest --test-dir build-tsan -j"$jobs" --output-on-failure --timeout 600 -LE slow \
-      -R '^(Extract|Passes|RandomFields|Verify|VerifyCatches|Dataset|MeshGeometry)\.'
+      -R '^(Extract|Passes|RandomFields|Verify|VerifyCatches|Dataset|MeshGeometry|Sweep)\.'

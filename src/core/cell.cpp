@@ -119,7 +119,7 @@ CellReport analyze_cell(const std::array<double, 8>& values, double iso, Method 
     report.base_case = detail::kBaseCase[config];
     if (config == 0 || config == 255) return report;
 
-    const detail::Decision d = detail::decide(values.data(), iso, config, method);
+    const detail::Decision d = detail::decide(values.data(), iso, config, method, detail::tables_of(method));
     report.subcase = d.subcase;
     describe(values.data(), iso, config, method, d, report);
     // Corner c at (c & 1, c >> 1 & 1, c >> 2 & 1) is sample (x, y, z) of a dense 2x2x2 grid.

@@ -321,6 +321,20 @@ template <class E> int algorithm1(const SweepT<E>& s)
     return f_sign * den_sign >= 0 ? 1 : -1;
 }
 
+/// Chernyaev's own test applied to case 13.5, as his algorithm does (Custodio et al. 2013, Sec. 3.1
+/// and 5.1, Issue I): joined iff (i) a < 0, (ii) t_max = -b/2a in (0, 1) and (iii) F(t_max) > 0,
+/// on the sweep of Appendix A. For case 13 the premise of these conditions (both end faces'
+/// saddles below, the saddle's denominator positive) does not hold, so they can err either way;
+/// that is the point of reproducing them. With a < 0, F(t_max) = (4ac - b^2)/4a has the sign of
+/// b^2 - 4ac; a zero counts as "not > 0".
+template <class E> bool chernyaev_13_5(const SweepT<E>& s)
+{
+    const E a = s.a(), b = s.b(), c = s.c();
+    if (sgn(a.x) >= 0) return false;                                // (i)
+    if (b.sign() <= 0 || (2.0 * a + b).sign() >= 0) return false;   // (ii)
+    return (b * b - 4.0 * (a * c)).sign() > 0;                      // (iii)
+}
+
 /// Lewiner et al.'s height: where the field crosses the reference edge (Custodio et al., Eq. 8).
 inline double t_alt(const double* v, int edge)
 {
@@ -332,12 +346,17 @@ inline double t_alt(const double* v, int edge)
 /// Algorithm 2 of Custodio et al. 2013 (Sec. 6.4), generalised to every variant with an interior
 /// ambiguity (cases 4, 6, 7, 10, 12 and 13.5): the face tests have chosen `var`; the interior test
 /// decides whether the tunnel is there, and for 13.5 which way it faces (tiling 1: the above
-/// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 every branch is
-/// tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces joined); the
-/// legacy policy of mc33-lewiner is read from the variant (Variant::lewiner).
+/// corner of the isolated diagonal, 2: the below one; 0: no tunnel). Under cmc33 (and cmc33-paper)
+/// every branch is tested, lines 16-20 of Algorithm 2 included (cases 10 and 12 with both faces
+/// joined); the legacy policy of mc33-lewiner is read from the variant (Variant::lewiner);
+/// chernyaev tests every branch with t_max, and 13.5 with his three conditions (chernyaev_13_5),
+/// its tunnel always facing the above corner: Chernyaev does not orient it (Sec. 5.1.1).
 template <class E> int algorithm2(const Variant& var, const E* ve, const double* v, Method method)
 {
     using R = typename E::Real;
+    if (method == Method::chernyaev && var.test == kTest13_5) {
+        return chernyaev_13_5(SweepT<E>(ve, var.axis, var.corner)) ? 1 : 0;
+    }
     if (method == Method::mc33_lewiner) {
         if (var.lewiner & kLewinerSkips) return 0; // Issue IV: never tested
         if (var.lewiner & kLewinerTAlt) {
@@ -365,9 +384,10 @@ struct Decision {
 /// decide() in the number type R (Filtered: may raise filter_uncertain; the others: exact), with
 /// the interior tests in E (EpsT<R>, or NoEps<R> for a first filtered pass). `raw` are the corner
 /// samples, `v` the same minus iso rounded to double (their signs, and mc33-lewiner's t_alt); the
-/// decisions use raw - iso computed in R.
+/// decisions use raw - iso computed in R. The variant is taken from `table` (kVariants or
+/// kLegacyVariants: the same decisions, other tubes).
 template <class R, class E = EpsT<R>>
-Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method)
+Decision decide_in(const double* raw, double iso, const double* v, unsigned config, Method method, const Variant* table)
 {
     R w[8];
     for (int q = 0; q < 8; ++q) w[q] = exact<R>(raw[q]) - exact<R>(iso);
@@ -389,7 +409,7 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
         }
         if (uncertain) filter_uncertain = true;
     }
-    const Variant* var = &kVariants[kVariantOffset[config] + bits];
+    const Variant* var = &table[kVariantOffset[config] + bits];
     if (var->test == kTestNone || method == Method::mc) return {var, 0, var->subcase, bits};
     E ve[8];
     for (int q = 0; q < 8; ++q) ve[q] = E{w[q], R(1.0)};
@@ -404,7 +424,8 @@ Decision decide_in(const double* raw, double iso, const double* v, unsigned conf
 /// about 2^100 apart (a degree-6 product of the smallest then falls below 2^-969: 1e-30 beside 1
 /// at a near-tie). There the expansions lose exactness, and this throws rather than return a
 /// decision that might be wrong.
-inline Decision decide_expansion(const double* raw, double iso, const double* v, unsigned config, Method method)
+inline Decision decide_expansion(const double* raw, double iso, const double* v, unsigned config, Method method,
+                                 const Variant* table = kVariants)
 {
     double largest = std::abs(iso);
     for (int q = 0; q < 8; ++q) largest = std::max(largest, std::abs(raw[q]));
@@ -419,7 +440,7 @@ inline Decision decide_expansion(const double* raw, double iso, const double* v,
     const double scaled_iso = std::ldexp(iso, -exponent);
     exact = exact && std::ldexp(scaled_iso, exponent) == iso;
     expansion_lost = false;
-    const Decision d = decide_in<Expansion>(scaled, scaled_iso, v, config, method);
+    const Decision d = decide_in<Expansion>(scaled, scaled_iso, v, config, method, table);
     if (!exact || expansion_lost) {
         expansion_lost = false;
         throw Error(Status::internal, "a cell's decision needs exact arithmetic beyond this build's range (corner values "
@@ -433,34 +454,43 @@ inline Decision decide_expansion(const double* raw, double iso, const double* v,
 /// iso are small multiples of a power of two (integer data, and integer-valued floats such as CT
 /// stored as float32: their ties cost what integer data's do); otherwise in filtered double
 /// arithmetic, and where rounding could change a sign, again exactly.
-/// `raw`: the eight corner samples (corner order of cube.hpp).
-inline Decision decide(const double* raw, double iso, unsigned config, Method method)
+/// `raw`: the eight corner samples (corner order of cube.hpp). `table`: the method's table set
+/// (tables_of(method)); Decision::variant points into it.
+inline Decision decide(const double* raw, double iso, unsigned config, Method method, const Variant* table = kVariants)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
 #if CMC33_HAS_INT128
     // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
-    if (method == Method::cmc33) {
+    if (method != Method::mc33_lewiner) {
         if (const double scale = small_integer_scale(raw, iso); scale != 0) {
             double scaled[8];
             for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
-            return decide_in<Int128>(scaled, iso * scale, v, config, method);
+            return decide_in<Int128>(scaled, iso * scale, v, config, method, table);
         }
     }
 #endif
     // first without eps terms (on data without ties no sign is 0), then with them
     filter_uncertain = false;
-    const Decision quick = decide_in<Filtered, NoEps<Filtered>>(raw, iso, v, config, method);
+    const Decision quick = decide_in<Filtered, NoEps<Filtered>>(raw, iso, v, config, method, table);
     if (!filter_uncertain) return quick;
     filter_uncertain = false;
-    const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method);
+    const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method, table);
     if (!filter_uncertain) return filtered;
     filter_uncertain = false;
 #if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
-    return decide_in<mpq_class>(raw, iso, v, config, method);
+    return decide_in<mpq_class>(raw, iso, v, config, method, table);
 #else
-    return decide_expansion(raw, iso, v, config, method);
+    return decide_expansion(raw, iso, v, config, method, table);
 #endif
+}
+
+/// The table set of a method: Chernyaev's tubes for the methods that reproduce Custodio et al.
+/// 2013 (chernyaev, mc33-lewiner, cmc33-paper), embedded tubes for cmc33 and mc.
+inline const Variant* tables_of(Method method)
+{
+    const bool legacy = method == Method::chernyaev || method == Method::mc33_lewiner || method == Method::cmc33_paper;
+    return legacy ? kLegacyVariants : kVariants;
 }
 
 } // namespace cmc33::detail

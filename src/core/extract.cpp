@@ -45,6 +45,7 @@
 #include "parallel.hpp"
 #include "placement.hpp"
 #include "portability.hpp"
+#include "refine.hpp"
 #include "mc33_tables.hpp"
 #include "thread_pool.hpp"
 
@@ -361,7 +362,7 @@ public:
           words_((nx_ + 63) / 64), sample_valid_(valid_words(words_, nx_)), x_valid_(valid_words(words_, nx_ - 1)),
           below_row_(static_cast<std::size_t>(words_ + 1), 0), above_row_(valid_words(words_ + 1, nx_)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
-          delta_(min_crossing(g, m_))
+          delta_(min_crossing(g, m_)), variants_(detail::tables_of(opt.method))
     {
         for (std::size_t a = 0; a < 3; ++a) {
             step_[a] = diagonal_ ? m_[a][a] : 1.0;
@@ -369,7 +370,7 @@ public:
         }
         if (!diagonal_) normal_map_ = inverse_transpose(m_);
         for (unsigned code = 0; code < 256; ++code) {
-            const detail::Variant& first = detail::kVariants[detail::kVariantOffset[code]];
+            const detail::Variant& first = variants_[detail::kVariantOffset[code]];
             const bool tested = opt.method != Method::mc &&
                                 (detail::kAmbiguousFaces[code] != 0 || first.test != detail::kTestNone);
             fixed_tiling_[code] = tested ? nullptr : &first.tilings[0];
@@ -678,7 +679,7 @@ private:
         for (int c = 0; c < 8; ++c) {
             raw[c] = static_cast<double>(at(i + kCornerOffset[c][0], j + kCornerOffset[c][1], k + kCornerOffset[c][2]));
         }
-        const detail::Decision d = detail::decide(raw, iso_, code, method_);
+        const detail::Decision d = detail::decide(raw, iso_, code, method_, variants_);
         subcase = d.subcase;
         decision = static_cast<std::uint8_t>(d.joined << 2 | static_cast<unsigned>(d.tiling));
         return d.variant->tilings[d.tiling];
@@ -688,15 +689,16 @@ private:
     static constexpr int kShortTiling = 4;
 
     /// kTriangleCodes followed by 3 * kShortTiling zeros, so that a short tiling's fixed-size copy
-    /// stays inside the table.
+    /// stays inside the table (both table sets index it).
     static const std::vector<std::uint8_t>& padded_codes()
     {
         static const std::vector<std::uint8_t> table = [] {
             std::size_t n = 0;
-            for (unsigned v = 0; v < detail::kVariantOffset[256]; ++v)
-                for (const detail::Tiling& t : detail::kVariants[v].tilings) {
-                    n = std::max<std::size_t>(n, (static_cast<std::size_t>(t.first_triangle) + t.triangle_count) * 3);
-                }
+            for (const detail::Variant* set : {detail::kVariants, detail::kLegacyVariants})
+                for (unsigned v = 0; v < detail::kVariantOffset[256]; ++v)
+                    for (const detail::Tiling& t : set[v].tilings) {
+                        n = std::max<std::size_t>(n, (static_cast<std::size_t>(t.first_triangle) + t.triangle_count) * 3);
+                    }
             std::vector<std::uint8_t> codes(detail::kTriangleCodes, detail::kTriangleCodes + n);
             codes.resize(n + 3 * kShortTiling, 0);
             return codes;
@@ -706,12 +708,12 @@ private:
 
     /// The tiling a decision byte of decide_cell() names for case code `code`; null when the byte
     /// cannot be one of that code's (the samples changed between count and emit).
-    static const detail::Tiling* replay(unsigned code, std::uint8_t decision)
+    const detail::Tiling* replay(unsigned code, std::uint8_t decision) const
     {
         const unsigned joined = decision >> 2u, tiling = decision & 3u;
         const unsigned variants = detail::kVariantOffset[code + 1] - detail::kVariantOffset[code];
         if (joined >= variants || tiling > 2) return nullptr;
-        return &detail::kVariants[detail::kVariantOffset[code] + joined].tilings[tiling];
+        return &variants_[detail::kVariantOffset[code] + joined].tilings[tiling];
     }
 
     /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
@@ -1137,6 +1139,9 @@ private:
     double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
     double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
+    /// The method's table set (detail::tables_of): chosen once here, so the passes' loops read one
+    /// pointer and nothing in them depends on the method
+    const detail::Variant* variants_;
     /// Per case code: its one tiling, or null when the method decides the cell (face or interior
     /// tests); and its subcase then.
     std::array<const detail::Tiling*, 256> fixed_tiling_{};
@@ -1194,9 +1199,20 @@ std::string range_text(std::int64_t k0, std::int64_t k1)
 
 } // namespace
 
+/// The passes run on the grid as it is; cmc33-paper may refine it first.
+static void check_passes_method(const ExtractOptions& options, const char* pass)
+{
+    if (options.method == Method::cmc33_paper) {
+        throw Error(Status::invalid_argument, std::string(pass) +
+                                                  ": method cmc33-paper refines the grid first (Custodio et al. 2013, "
+                                                  "Sec. 6.2), which the passes cannot; use extract(), or another method");
+    }
+}
+
 template <class T>
 RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1)
 {
+    check_passes_method(options, "count");
     check_grid(grid, iso);
     if (!(0 <= k0 && k0 < k1 && k1 <= grid.nz())) {
         throw Error(Status::invalid_argument, "count: sample planes " + range_text(k0, k1) + "; expected 0 <= k0 < k1 <= " +
@@ -1231,6 +1247,7 @@ template <class T>
 void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out)
 {
+    check_passes_method(options, "emit");
     check_grid(grid, iso);
     if (counts.k1() > grid.nz() || counts.k0() >= counts.k1() || !RangeExtractor<T>::same_rows(counts, grid)) {
         throw Error(Status::invalid_argument, "emit: the counts of planes " + range_text(counts.k0(), counts.k1()) +
@@ -1242,6 +1259,17 @@ void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, co
 }
 
 template <class T> Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
+{
+    if (options.method == Method::cmc33_paper) {
+        check_grid(grid, iso);
+        scan_samples(grid, 0, grid.nz() - 1); // refine.cpp decides cells before any pass has read them
+        return detail::extract_refined(grid, iso, options, stats);
+    }
+    return detail::extract_passes(grid, iso, options, stats);
+}
+
+template <class T>
+Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
 {
     check_grid(grid, iso);
     const std::int64_t nz = grid.nz();
@@ -1303,6 +1331,7 @@ Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, Ex
 
 #define CMC33_INSTANTIATE(T)                                                                                    \
     template Mesh extract<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);                       \
+    template Mesh detail::extract_passes<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);        \
     template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
     template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
                           const MeshSpans&);

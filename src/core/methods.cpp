@@ -14,6 +14,8 @@ std::string_view method_name(Method method) noexcept
     switch (method) {
     case Method::cmc33: return "cmc33";
     case Method::mc33_lewiner: return "mc33-lewiner";
+    case Method::chernyaev: return "chernyaev";
+    case Method::cmc33_paper: return "cmc33-paper";
     case Method::mc: break;
     }
     return "mc";
@@ -21,11 +23,11 @@ std::string_view method_name(Method method) noexcept
 
 Method parse_method(std::string_view name)
 {
-    for (Method m : {Method::cmc33, Method::mc33_lewiner, Method::mc}) {
+    for (Method m : {Method::cmc33, Method::cmc33_paper, Method::chernyaev, Method::mc33_lewiner, Method::mc}) {
         if (name == method_name(m)) return m;
     }
-    throw Error(Status::invalid_argument,
-                "unknown method '" + std::string(name) + "'; expected cmc33, mc33-lewiner or mc");
+    throw Error(Status::invalid_argument, "unknown method '" + std::string(name) +
+                                              "'; expected cmc33, cmc33-paper, chernyaev, mc33-lewiner or mc");
 }
 
 std::string_view subcase_name(int subcase) noexcept

@@ -13,6 +13,12 @@
 // Tiling vertex codes: 0..11 = the crossing on that cube edge; 12 + k = the k-th interior vertex,
 // placed at the mean of the crossings on the edges of kInteriorMasks[first_interior + k].
 // Triangles wind so that normals point from the above side to the below side.
+//
+// Two table sets, from the generator's switch `tunnels`: kVariants (embedded tubes through interior
+// vertices; cmc33, mc) and kLegacyVariants (Chernyaev's tubes without interior vertices, which lie
+// in a cell face where they cross an ambiguous face's band: chernyaev, mc33-lewiner, cmc33-paper,
+// Custodio et al. 2013 Sec. 5.2). They have the same variants in the same order and differ only in
+// the tube tilings; both index kTriangleCodes and kInteriorMasks.
 
 #include <cstdint>
 
@@ -58,7 +64,8 @@ extern const char* const kSubcaseNames[33];      ///< Chernyaev's subcase names,
 extern const std::uint8_t kAmbiguousFaces[256]; ///< bit f: face f has its above corners diagonal
 extern const std::uint8_t kBaseCase[256];       ///< Chernyaev / Lorensen base case 0..14
 extern const std::uint16_t kVariantOffset[257];
-extern const Variant kVariants[];
+extern const Variant kVariants[];       ///< embedded tubes
+extern const Variant kLegacyVariants[]; ///< Chernyaev's tubes; otherwise kVariants, entry by entry
 extern const std::uint8_t kTriangleCodes[];
 extern const std::uint16_t kInteriorMasks[];
 

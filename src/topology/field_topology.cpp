@@ -92,7 +92,8 @@
 //   boundary linked by the arcs of the boundary faces (each such crossing has two such arcs, so
 //   the classes are closed curves). b1 = b0 + b2 - chi, since S is a compact orientable surface.
 //
-// Cost: one pass over the cells; a cell with one loop costs a table lookup. Working memory is two
+// Cost: one pass over the samples to find the rows of cells that are all above or all below (skipped),
+// then one over the other cells; a cell with one loop costs a table lookup. Working memory is two
 // planes of edge ids plus 9 bytes per crossed grid edge; no allocation per cell except on the
 // rare exact-arithmetic fallback (ties).
 
@@ -385,6 +386,27 @@ template <class T> void check_finite(const GridView<T>& grid)
     }
 }
 
+/// f[i] = 1 if sample i of the row at r (stride sx) is above iso (the sign rule: >=, as
+/// cell_code), else 0. Integers compare with ceil(iso) in their own type: the same answers, and
+/// a contiguous row is a loop the compiler vectorises.
+template <class T> void above_flags(const T* r, std::int64_t n, std::int64_t sx, double iso, std::uint8_t* f)
+{
+    if constexpr (std::is_integral_v<T>) {
+        if (iso > static_cast<double>(std::numeric_limits<T>::max()) || iso <= static_cast<double>(std::numeric_limits<T>::lowest())) {
+            std::fill(f, f + n, static_cast<std::uint8_t>(iso <= static_cast<double>(std::numeric_limits<T>::lowest())));
+            return;
+        }
+        const auto threshold = static_cast<T>(std::ceil(iso)); // within T's range: lowest < iso <= max
+        if (sx == 1) {
+            for (std::int64_t i = 0; i < n; ++i) f[i] = static_cast<std::uint8_t>(r[i] >= threshold);
+        } else {
+            for (std::int64_t i = 0; i < n; ++i) f[i] = static_cast<std::uint8_t>(r[i * sx] >= threshold);
+        }
+    } else {
+        for (std::int64_t i = 0; i < n; ++i) f[i] = static_cast<std::uint8_t>(static_cast<double>(r[i * sx]) >= iso);
+    }
+}
+
 } // namespace
 } // namespace topology::detail
 
@@ -397,14 +419,46 @@ template <class T> FieldTopology field_topology(const GridView<T>& grid, double 
 
     Assembler assembler(grid.dims, options.max_refinement);
     const std::int64_t sx = grid.strides[0]; // any stride: a view of a larger or reordered array
-    for (std::int64_t k = 0; k + 1 < grid.nz(); ++k) {
+    // Each sample row's above-flags (the sign rule, as cell_code), and its side of iso: all above,
+    // all below, or mixed. A row of cells whose four sample rows are all above or all below holds
+    // no crossed cell (most rows of a CT volume); in the others a cell's code comes from the
+    // flags, and only crossed cells read their values.
+    enum : std::uint8_t { kRowBelow = 1, kRowAbove = 2 };
+    const std::int64_t nx = grid.nx(), ny = grid.ny(), nz = grid.nz();
+    std::vector<std::uint8_t> row_side(static_cast<std::size_t>(ny * nz));
+    std::vector<std::uint8_t> flags(static_cast<std::size_t>(nx * ny * 2)); // two slices of rows
+    const auto flags_of = [&](std::int64_t j, std::int64_t k) {
+        return &flags[static_cast<std::size_t>(nx * (j + ny * (k % 2)))];
+    };
+    const auto classify_slice = [&](std::int64_t k) {
+        for (std::int64_t j = 0; j < ny; ++j) {
+            std::uint8_t* f = flags_of(j, k);
+            above_flags(grid.data + grid.offset(0, j, k), nx, sx, iso, f);
+            unsigned any = 0, all = 1;
+            for (std::int64_t i = 0; i < nx; ++i) {
+                any |= f[i];
+                all &= f[i];
+            }
+            row_side[static_cast<std::size_t>(j + ny * k)] = static_cast<std::uint8_t>((all ? kRowAbove : 0) | (any ? 0 : kRowBelow));
+        }
+    };
+    classify_slice(0);
+    for (std::int64_t k = 0; k + 1 < nz; ++k) {
+        classify_slice(k + 1);
         assembler.begin_slab(k);
-        for (std::int64_t j = 0; j + 1 < grid.ny(); ++j) {
+        for (std::int64_t j = 0; j + 1 < ny; ++j) {
+            const auto side = [&](std::int64_t jj, std::int64_t kk) { return row_side[static_cast<std::size_t>(jj + ny * kk)]; };
+            if ((side(j, k) & side(j + 1, k) & side(j, k + 1) & side(j + 1, k + 1)) != 0) continue;
             const T* r0 = grid.data + grid.offset(0, j, k);         // (., j,     k    )
             const T* r1 = grid.data + grid.offset(0, j + 1, k);     // (., j + 1, k    )
             const T* r2 = grid.data + grid.offset(0, j, k + 1);     // (., j,     k + 1)
             const T* r3 = grid.data + grid.offset(0, j + 1, k + 1); // (., j + 1, k + 1)
-            for (std::int64_t i = 0; i + 1 < grid.nx(); ++i) {
+            const std::uint8_t *f0 = flags_of(j, k), *f1 = flags_of(j + 1, k), *f2 = flags_of(j, k + 1),
+                               *f3 = flags_of(j + 1, k + 1);
+            for (std::int64_t i = 0; i + 1 < nx; ++i) {
+                const unsigned quick = f0[i] | f0[i + 1] << 1 | f1[i] << 2 | f1[i + 1] << 3 | f2[i] << 4 |
+                                       f2[i + 1] << 5 | f3[i] << 6 | f3[i + 1] << 7;
+                if (quick == 0 || quick == 255) continue;
                 CellInput in;
                 in.iso = iso;
                 in.v[0] = static_cast<double>(r0[i * sx]);
@@ -416,7 +470,6 @@ template <class T> FieldTopology field_topology(const GridView<T>& grid, double 
                 in.v[6] = static_cast<double>(r3[i * sx]);
                 in.v[7] = static_cast<double>(r3[(i + 1) * sx]);
                 const unsigned code = cell_code(in);
-                if (code == 0 || code == 255) continue;
                 if (!assembler.add_cell(in, code, i, j, k)) {
                     FieldTopology undetermined;
                     undetermined.why = assembler.why();

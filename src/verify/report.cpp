@@ -23,6 +23,7 @@ void add(MethodReport& into, const MethodReport& from)
     into.checked += from.checked;
     into.matched += from.matched;
     into.mismatched += from.mismatched;
+    into.topology_mismatched += from.topology_mismatched;
     into.undetermined += from.undetermined;
     into.nonmanifold += from.nonmanifold;
     into.unoriented += from.unoriented;
@@ -31,10 +32,14 @@ void add(MethodReport& into, const MethodReport& from)
     for (std::size_t k = 0; k < into.checked_by_kind.size(); ++k) {
         into.checked_by_kind[k] += from.checked_by_kind[k];
         into.mismatched_by_kind[k] += from.mismatched_by_kind[k];
+        into.topology_mismatched_by_kind[k] += from.topology_mismatched_by_kind[k];
     }
     for (std::size_t s = 0; s < into.fields_per_subcase.size(); ++s) {
         into.fields_per_subcase[s] += from.fields_per_subcase[s];
         into.mismatches_per_subcase[s] += from.mismatches_per_subcase[s];
+        into.topology_mismatches_per_subcase[s] += from.topology_mismatches_per_subcase[s];
+        into.cells_per_subcase[s] += from.cells_per_subcase[s];
+        into.cell_topology_mismatches_per_subcase[s] += from.cell_topology_mismatches_per_subcase[s];
     }
 }
 
@@ -78,15 +83,27 @@ bool record(Tally& tally, Outcome&& outcome, int max_failures)
 {
     MethodReport& r = tally.report;
     const auto k = static_cast<std::size_t>(outcome.kind);
+    const bool cell = outcome.kind == FieldKind::cell;
     ++r.checked;
     ++r.checked_by_kind[k];
-    for (int s : outcome.subcases) ++r.fields_per_subcase[static_cast<std::size_t>(s)];
+    for (int s : outcome.subcases) {
+        ++r.fields_per_subcase[static_cast<std::size_t>(s)];
+        if (cell) ++r.cells_per_subcase[static_cast<std::size_t>(s)];
+    }
     std::optional<MeshTopology> got;
     bool ok = false;
     if (!outcome.mesh) {
         ++r.errors;
     } else {
         got = mesh_topology(*outcome.mesh);
+        if (!topology_matches(*got, *outcome.expected)) {
+            ++r.topology_mismatched;
+            ++r.topology_mismatched_by_kind[k];
+            for (int s : outcome.subcases) {
+                ++r.topology_mismatches_per_subcase[static_cast<std::size_t>(s)];
+                if (cell) ++r.cell_topology_mismatches_per_subcase[static_cast<std::size_t>(s)];
+            }
+        }
         const bool manifold = is_manifold(*got);
         if (!manifold) ++r.nonmanifold;
         if (got->faces > 0 && !got->oriented) ++r.unoriented;

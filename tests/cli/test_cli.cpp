@@ -825,7 +825,7 @@ TEST(CliVerify, DefaultIsCmc33AloneAndWritesNoFailuresFolder)
                            quote((dir / "failed").string()));
     EXPECT_EQ(all.code, 1);
     j = parse(all);
-    ASSERT_EQ(j["methods"].size(), 3u);
+    ASSERT_EQ(j["methods"].size(), 5u); // cmc33, cmc33-paper, chernyaev, mc33-lewiner, mc
     EXPECT_EQ(j["failures"]["dir"], (dir / "failed").string());
     EXPECT_TRUE(fs::exists(dir / "failed" / "failures.tsv"));
     EXPECT_NE(all.err.find("failures in " + (dir / "failed").string()), std::string::npos) << all.err;

@@ -25,7 +25,7 @@ Decision exact(const double* raw, double iso, unsigned config, Method method)
 {
     double v[8];
     for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
-    return cmc33::detail::decide_in<mpq_class>(raw, iso, v, config, method);
+    return cmc33::detail::decide_in<mpq_class>(raw, iso, v, config, method, cmc33::detail::kVariants);
 }
 
 unsigned config_of(const double* raw, double iso)
@@ -45,7 +45,7 @@ template <class Draw> int compare(Draw&& draw, double iso, int cells, std::uint6
         for (double& x : raw) x = draw(rng);
         const unsigned config = config_of(raw, iso);
         if (config == 0 || config == 255) continue;
-        for (const Method method : {Method::cmc33, Method::mc33_lewiner}) {
+        for (const Method method : {Method::cmc33, Method::chernyaev, Method::mc33_lewiner}) {
             const Decision got = cmc33::detail::decide(raw, iso, config, method);
             const Decision want = exact(raw, iso, config, method);
             double v[8];

@@ -20,7 +20,15 @@ using cmc33::ExtractOptions;
 using cmc33::Method;
 using cmc33::Volume;
 
-const Method kMethods[] = {Method::cmc33, Method::mc33_lewiner, Method::mc};
+const Method kMethods[] = {Method::cmc33, Method::mc33_lewiner, Method::mc, Method::chernyaev};
+
+/// Methods with the embedded table set: manifold and embedded by construction. The others use
+/// Chernyaev's tubes, which lie in a cell face and meet a neighbour's there (Custodio et al. 2013,
+/// Sec. 5.2): tests/core/test_paper.cpp shows those flaws.
+bool embedded_tubes(Method m)
+{
+    return m == Method::cmc33 || m == Method::mc;
+}
 
 Volume sphere(int n, double r)
 {
@@ -145,8 +153,10 @@ TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
         for (Method m : kMethods) {
             const cmc33::Mesh mesh = cmc33::extract(v, 80.0, {m});
             const auto t = cmc33::mesh_topology(mesh);
-            EXPECT_EQ(t.nonmanifold_edges, 0);
-            EXPECT_EQ(t.nonmanifold_vertices, 0);
+            if (embedded_tubes(m)) {
+                EXPECT_EQ(t.nonmanifold_edges, 0);
+                EXPECT_EQ(t.nonmanifold_vertices, 0);
+            }
             EXPECT_EQ(t.degenerate_triangles, 0);
             EXPECT_TRUE(t.oriented);
             // boundary edges only on the volume's outer faces
@@ -178,9 +188,9 @@ TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
     }
 }
 
-// Ties in space (docs/conventions.md, "Geometry"): every method's mesh is embedded, its vertices
-// keep at least delta = 2^-10 of an edge away from every sample, and welding by position changes
-// nothing.
+// Ties in space (docs/conventions.md, "Geometry"): the mesh of every method with embedded tubes is
+// embedded, and every method's vertices keep at least delta = 2^-10 of an edge away from every
+// sample; welding by position changes nothing.
 TEST(Extract, TiesAreEmbeddedAndStayOffTheSamples)
 {
     std::mt19937_64 rng(11);
@@ -191,12 +201,15 @@ TEST(Extract, TiesAreEmbeddedAndStayOffTheSamples)
         for (Method m : kMethods) {
             const cmc33::Mesh mesh = cmc33::extract(v, 80.0, {m});
             const cmc33::MeshGeometry g = cmc33::mesh_geometry(mesh);
-            EXPECT_TRUE(g.embedded()) << g.coincident_vertices << " coincident, " << g.zero_area_triangles << " zero-area, "
-                                      << g.intersecting_pairs << " intersecting";
             const auto t = cmc33::mesh_topology(mesh);
+            EXPECT_EQ(g.coincident_vertices, 0);
+            EXPECT_EQ(g.zero_area_triangles, 0);
             EXPECT_EQ(g.welded.euler, t.euler);
             EXPECT_EQ(g.welded.components, t.components);
-            EXPECT_EQ(g.welded.nonmanifold_edges, 0);
+            if (embedded_tubes(m)) {
+                EXPECT_EQ(g.intersecting_pairs, 0) << cmc33::method_name(m);
+                EXPECT_EQ(g.welded.nonmanifold_edges, 0);
+            }
             for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
                 // grid coordinates; the distance to the nearest sample along each axis
                 const double x[3] = {(static_cast<double>(mesh.positions[3 * q]) + 3.0) / 0.5,
@@ -347,7 +360,7 @@ TEST(Extract, RejectsNonFiniteAndTooSmallGrids)
 // methods do not always (Custodio et al. 2013). Compared with the independent field topology.
 TEST(Extract, RandomGridsMatchTheFieldTopology)
 {
-    int mismatches[3] = {0, 0, 0};
+    int mismatches[4] = {0, 0, 0, 0};
     int undetermined = 0;
     for (std::uint64_t seed = 0; seed < 400; ++seed) {
         const Volume v = noise({5, 5, 5}, 1000 + seed);
@@ -356,7 +369,7 @@ TEST(Extract, RandomGridsMatchTheFieldTopology)
             ++undetermined;
             continue;
         }
-        for (int m = 0; m < 3; ++m) {
+        for (int m = 0; m < 4; ++m) {
             const auto t = cmc33::mesh_topology(cmc33::extract(v, 0.0, {kMethods[m]}));
             if (kMethods[m] == Method::cmc33) {
                 EXPECT_EQ(t.nonmanifold_edges, 0);

@@ -149,6 +149,60 @@ TEST(AppendixA, LewinerMissesItByBothRoutes)
     EXPECT_FALSE(r.interior.tunnel);
 }
 
+TEST(AppendixA, ChernyaevMissesItByConditionI)
+{
+    // Issue I: on case 13.5 Chernyaev's own conditions run on the sweep of Appendix A; a > 0 fails (i)
+    const cmc33::CellReport r = cmc33::analyze_cell(kAppendixA, 0.0, Method::chernyaev);
+    EXPECT_EQ(cmc33::subcase_name(r.subcase), "13.5.1");
+    EXPECT_NEAR(r.interior.a, 0.3296, 2e-4);
+    EXPECT_FALSE(r.interior.tunnel);
+    EXPECT_FALSE(r.interior.skipped);
+}
+
+// chernyaev is cmc33's policy but for case 13.5 (Issue I): on random cells the two decide alike
+// everywhere else, including the joined branch of cases 10 and 12 that mc33-lewiner skips. In 13.5
+// Chernyaev's conditions err both ways (C13 Sec. 5.1: 13.5.2 taken for 13.5.1 and the reverse),
+// and where they do the field's topology (independent of the kernel) sides with cmc33.
+TEST(Methods, ChernyaevDiffersFromCmc33OnlyInCase13_5)
+{
+    std::mt19937_64 rng(1995);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int case13_5 = 0, missed = 0, invented = 0, joined_branch = 0;
+    for (int n = 0; n < 300000; ++n) {
+        std::array<double, 8> v{};
+        unsigned config = 0;
+        // case-13 configurations with magnitudes near one level (where 13.5.2 lives), and uniform cells
+        const bool near = n % 2 == 0;
+        const double level = 0.2 + 0.8 * std::abs(u(rng));
+        for (int c = 0; c < 8; ++c) {
+            const int sign = near ? (((0x69u >> c) & 1u) ? 1 : -1) : 0;
+            v[static_cast<std::size_t>(c)] = near ? sign * level * (1 + 0.3 * u(rng)) : u(rng);
+            config |= static_cast<unsigned>(v[static_cast<std::size_t>(c)] >= 0) << c;
+        }
+        if (config == 0 || config == 255) continue;
+        const auto ours = cmc33::detail::decide(v.data(), 0.0, config, Method::cmc33);
+        const auto his = cmc33::detail::decide(v.data(), 0.0, config, Method::chernyaev, cmc33::detail::kLegacyVariants);
+        joined_branch += (ours.variant->lewiner & cmc33::detail::kLewinerSkips) != 0;
+        if (ours.variant->test != cmc33::detail::kTest13_5) {
+            ASSERT_EQ(ours.subcase, his.subcase) << "config " << config;
+            ASSERT_EQ(ours.tiling, his.tiling) << "config " << config;
+            continue;
+        }
+        ++case13_5;
+        if (ours.subcase == his.subcase) continue;
+        const cmc33::FieldTopology f = field_of(v, 0.0);
+        ASSERT_TRUE(f.determined) << f.why;
+        // 13.5.2 is one tube and a disc (euler 1); 13.5.1 three discs (euler 3)
+        EXPECT_EQ(f.euler, ours.tiling != 0 ? 1 : 3);
+        missed += ours.tiling != 0;
+        invented += ours.tiling == 0;
+    }
+    EXPECT_GT(case13_5, 1000);
+    EXPECT_GT(joined_branch, 100);
+    EXPECT_GT(missed, 0) << "13.5.2 taken for 13.5.1";
+    EXPECT_GT(invented, 0) << "13.5.1 taken for 13.5.2";
+}
+
 TEST(Methods, McNeverTestsAndLewinerSkipsTheJoinedBranch)
 {
     // Case 10 with both faces joined: cmc33 tests the interior, mc33-lewiner does not (Sec. 5.4).
@@ -211,7 +265,7 @@ TEST(Algorithm2, TheJoinedBranchOfCases10And12IsTestedByCmc33AndSkippedByLewiner
 TEST(AnalyzeCell, ItsMeshIsExtractOfTheCell)
 {
     for (const auto& cell : kCells) {
-        for (const Method m : {Method::cmc33, Method::mc33_lewiner, Method::mc}) {
+        for (const Method m : {Method::cmc33, Method::mc33_lewiner, Method::mc, Method::chernyaev}) {
             const cmc33::CellReport r = cmc33::analyze_cell(cell.values, 0.0, m);
             cmc33::ExtractOptions o;
             o.method = m;

@@ -82,7 +82,9 @@ std::array<double, 3> mid(int e)
     return m;
 }
 
-TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
+/// Checks every tiling of one table set. `legacy`: kLegacyVariants, whose tubes may have chords
+/// inside an ambiguous face (Chernyaev's style) and have no interior vertices.
+void check_table_set(const Variant* table, bool legacy)
 {
     int checked = 0;
     for (unsigned config = 1; config < 255; ++config) {
@@ -100,7 +102,7 @@ TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
                     arc_face[a] = f;
                 }
             }
-            const Variant& var = kVariants[kVariantOffset[config] + bits];
+            const Variant& var = table[kVariantOffset[config] + bits];
             const int tilings = var.test == kTestNone ? 1 : var.test == kTestTunnel ? 2 : 3;
             for (int t = 0; t < tilings; ++t) {
                 SCOPED_TRACE("config " + std::to_string(config) + " bits " + std::to_string(bits) + " tiling " + std::to_string(t));
@@ -120,8 +122,13 @@ TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
                         ASSERT_LT(a, 12 + tl.interior_count);
                         verts.insert(a);
                         ++directed[{a, b}];
-                        if (a < 12 && b < 12 && share_face(a, b)) {
-                            ASSERT_TRUE(arcs.count({std::min(a, b), std::max(a, b)})) << "chord inside a face " << a << "-" << b;
+                        if (a < 12 && b < 12 && share_face(a, b) && !arcs.count({std::min(a, b), std::max(a, b)})) {
+                            // only a legacy tube lies in a face, and only in an ambiguous one
+                            ASSERT_TRUE(legacy && t > 0) << "chord inside a face " << a << "-" << b;
+                            bool in_ambiguous = false;
+                            for (int f : edge_faces(a))
+                                for (int g : edge_faces(b)) in_ambiguous |= f == g && ((amb >> f) & 1u) != 0;
+                            ASSERT_TRUE(in_ambiguous) << "legacy chord " << a << "-" << b << " outside the ambiguous faces";
                         }
                     }
                 }
@@ -182,11 +189,82 @@ TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
                     }
                 }
                 EXPECT_EQ(euler, t == 0 ? loops : loops - 2);
+                if (legacy && t > 0) {
+                    EXPECT_EQ(tl.interior_count, 0) << "a legacy tube joins the loops directly";
+                }
                 ++checked;
             }
         }
     }
     EXPECT_GT(checked, 700);
+}
+
+TEST(Tables, EveryTilingIsAManifoldPatchBoundedByTheFaceArcs)
+{
+    check_table_set(kVariants, false);
+}
+
+TEST(Tables, EveryLegacyTilingIsAManifoldPatchBoundedByTheFaceArcs)
+{
+    check_table_set(kLegacyVariants, true);
+}
+
+/// Faces f such that a triangle of the tiling has its three vertices on edges of f.
+unsigned faces_holding_a_triangle(const Tiling& tl)
+{
+    unsigned faces = 0;
+    for (int q = 0; q < tl.triangle_count; ++q) {
+        const std::uint8_t* tri = &kTriangleCodes[(tl.first_triangle + q) * 3];
+        if (tri[0] >= 12 || tri[1] >= 12 || tri[2] >= 12) continue;
+        for (int f : edge_faces(tri[0]))
+            for (int g : edge_faces(tri[1]))
+                for (int h : edge_faces(tri[2]))
+                    if (f == g && g == h) faces |= 1u << f;
+    }
+    return faces;
+}
+
+// The two sets differ exactly in the tubes (Issue II of Custodio et al. 2013): the legacy tube of
+// every tunnel subcase that crosses an ambiguous face lies in that face (Fig. 8, bottom: "each has
+// a face that is coplanar to the voxel faces"); 4.1.2, whose tube runs along the cell's diagonal
+// and crosses no ambiguous face, never does; no other tiling of either set lies in a face.
+TEST(Tables, LegacyTubesLieInAFaceWhereTheEmbeddedOnesNeverDo)
+{
+    std::map<std::string, int> in_face, tubes;
+    for (unsigned config = 0; config < 256; ++config) {
+        for (unsigned v = kVariantOffset[config]; v < kVariantOffset[config + 1]; ++v) {
+            const Variant& e = kVariants[v];
+            const Variant& l = kLegacyVariants[v];
+            const auto decisions = [](const Variant& x) {
+                return std::array<int, 9>{x.subcase, x.tunnel_subcase, x.test, x.axis, x.corner, x.lewiner_axis,
+                                          x.lewiner_corner, x.lewiner_edge, x.lewiner};
+            };
+            ASSERT_EQ(decisions(e), decisions(l)) << "variant " << v << ": the decisions' fields differ";
+            const int tilings = e.test == kTestNone ? 1 : e.test == kTestTunnel ? 2 : 3;
+            for (int t = 0; t < 3; ++t) {
+                EXPECT_EQ(faces_holding_a_triangle(e.tilings[t]), 0u) << "variant " << v;
+                if (t == 0 || t >= tilings) {
+                    const auto same = [](const Tiling& a, const Tiling& b) {
+                        return a.triangle_count == b.triangle_count && a.interior_count == b.interior_count &&
+                               a.first_triangle == b.first_triangle && a.first_interior == b.first_interior;
+                    };
+                    EXPECT_TRUE(same(e.tilings[t], l.tilings[t])) << "variant " << v << " tiling " << t;
+                    continue;
+                }
+                const std::string name = std::string(kSubcaseNames[e.tunnel_subcase]);
+                const unsigned faces = faces_holding_a_triangle(l.tilings[t]);
+                EXPECT_EQ(faces & ~static_cast<unsigned>(kAmbiguousFaces[config]), 0u) << "variant " << v;
+                ++tubes[name];
+                in_face[name] += faces != 0;
+            }
+        }
+    }
+    for (const char* name : {"6.1.2", "7.4.2", "10.1.2", "12.1.2", "13.5.2"}) {
+        EXPECT_GT(tubes[name], 0) << name;
+        EXPECT_EQ(in_face[name], tubes[name]) << name << ": every legacy tube crosses its ambiguous face in it";
+    }
+    EXPECT_GT(tubes["4.1.2"], 0);
+    EXPECT_EQ(in_face["4.1.2"], 0);
 }
 
 TEST(Tables, BaseCasesFollowTheSignConfigurationCounts)

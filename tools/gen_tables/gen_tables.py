@@ -16,8 +16,24 @@ How (design.md, "Tables"):
     vertices, so it never touches a face either.
  5. Every tiling is checked: crossing vertices only on crossed edges, boundary = the face arcs each
     used once in loop direction, every inner edge used twice in opposite directions, no face chord.
+
+The switch `tunnels` of variants() (TUNNEL_STYLES) chooses how step 3 builds a tube:
+ - "embedded" (kVariants, used by cmc33 and mc): the tube of step 4, through a ring of interior
+   vertices, never touching a face but along its arcs;
+ - "legacy" (kLegacyVariants, used by chernyaev, mc33-lewiner and cmc33-paper to reproduce
+   Custodio et al. 2013): Chernyaev's style, a strip of triangles joining the two loops directly,
+   without interior vertices (legacy_tube()). Where both loops have an arc on an ambiguous face
+   and the tube's outside lies between them there, the strip runs through that band as a
+   quadrilateral lying IN the face: the "face coplanar to the voxel faces" of the paper's Fig. 8
+   (bottom). Two neighbouring cells whose tunnels share that face both put it there, and its
+   sides get four triangles: the non-manifold edges of Sec. 5.2.
+   Only the tube tilings differ; every other tiling (discs) is the embedded one, so the two table
+   sets differ exactly where the paper's Issue II is.
+Both sets go into the one generated file; they share kTriangleCodes and kInteriorMasks (the legacy
+tubes are appended after the embedded tables, which are unchanged by the switch).
 Run: python3 tools/gen_tables/gen_tables.py > src/tables/mc33_tables.cpp  (a test checks it is current)
 """
+import itertools
 import math
 import sys
 import os
@@ -325,19 +341,122 @@ def tube(config, joined, ls, pair, interior):
     return tris[:walls] + graph
 
 
-def tiling(ls, joined_pair=None, config=None, joined=None):
+def legacy_bands(config, joined, ls, pair):
+    """Faces where the tube of legacy_tube() lies in the face: ambiguous faces on which loop
+    ls[pair[0]] has an arc a->b and ls[pair[1]] an arc c->d with the piece of the face between them
+    inside the tube's outside region. Returns [(face, (a, b), (c, d))]."""
+    regs, sides = loop_regions(config, joined, ls)
+    (common,) = sides[pair[0]] & sides[pair[1]]
+    region = regs[common]
+    arcs = [{(l[i][0], l[(i + 1) % len(l)][0]): l[i][1] for i in range(len(l))} for l in (ls[pair[0]], ls[pair[1]])]
+    out = []
+    for f in ambiguous_faces(config):
+        on_face = [[arc for arc, face in a.items() if face == f] for a in arcs]
+        if len(on_face[0]) != 1 or len(on_face[1]) != 1:
+            continue
+        (ab,), (cd,) = on_face
+        for piece in face_pieces(config, joined, f):
+            points = {p[1] for p in piece if p[0] == "e"}
+            corners = {p[1] for p in piece if p[0] == "c"}
+            if points == set(ab) | set(cd) and corners <= region:
+                out.append((f, ab, cd))
+    return out
+
+
+def legacy_tube(config, joined, ls, pair):
+    """Chernyaev's tube (Custodio et al. 2013, Sec. 5.2 and Fig. 8, bottom): a strip of triangles
+    joining loop U = ls[pair[0]] and loop V = ls[pair[1]] directly, without interior vertices. The
+    strip walks U forward and V backward (so that both loops are used in their own direction):
+    every triangle is (u_i, u_i+1, v_j) or (v_j-1, v_j, u_i). Across each band of legacy_bands()
+    the strip must pass through the rungs (a, d) and (b, c), so the band's quadrilateral
+    a, b, c, d lies in the face; no other rung lies in a face. Among such strips the one with the
+    shortest rungs (between edge midpoints) is taken."""
+    U = [e for e, _ in ls[pair[0]]]
+    V = [e for e, _ in ls[pair[1]]]
+    m, n = len(U), len(V)
+    forced, in_band = [], set()
+    for _, (a, b), (c, d) in legacy_bands(config, joined, ls, pair):
+        forced += [(a, d), (b, c)]
+        in_band |= {(a, d), (b, c), (b, d)}  # the band's sides and one diagonal
+    # no other rung may lie in a face: it would cross the band's diagonal or a face's corner region
+    rung = lambda u, v: dist(edge_mid(u), edge_mid(v)) if (u, v) in in_band or not share_face(u, v) else float("inf")
+    best = None
+    for s, t in itertools.product(range(m), range(n)):
+        u = lambda i: U[(s + i) % m]
+        v = lambda j: V[(t - j) % n]
+        # states (i, j): rung (u(i), v(j)) after i forward steps on U and j backward steps on V;
+        # (m, n) is the start rung again. A forced rung at the start's u or v has two states
+        # (i = 0 or m, j = 0 or n): the path must visit one of them, so each choice is tried.
+        copies = [[(i, j) for i in range(m + 1) for j in range(n + 1) if (u(i), v(j)) == r] for r in sorted(set(forced))]
+        for need in itertools.product(*copies):
+            cand = strip(u, v, m, n, need, rung)
+            if cand is not None and (best is None or cand[0] < best[0] - 1e-12):
+                best = cand
+    assert best is not None, ("no legacy strip", config, joined)
+    return best[1]
+
+
+def strip(u, v, m, n, need, rung):
+    """The strip of least total rung length from state (0, 0) to (m, n) through every state of
+    `need` (a monotone lattice path visits (fi, fj) iff it never enters a state strictly on one
+    side of it in i and the other in j), or None. The first step is along U and the last along V,
+    and (m, 0) is never entered: then no rung but the start is met twice (states (0, j) and
+    (m, j), or (i, 0) and (i, n), are one rung), and the strip is an annulus."""
+    ok = lambda i, j: (i, j) not in ((m, 0), (0, 1)) and \
+        all(not ((i < fi and j > fj) or (i > fi and j < fj)) for fi, fj in need)
+    inf = float("inf")
+    cost = [[inf] * (n + 1) for _ in range(m + 1)]
+    came = [[None] * (n + 1) for _ in range(m + 1)]
+    cost[0][0] = rung(u(0), v(0))
+    for i in range(m + 1):
+        for j in range(n + 1):
+            if (i, j) == (0, 0) or not ok(i, j) or rung(u(i), v(j)) == inf:
+                continue
+            here = rung(u(i), v(j))
+            for pi, pj, step in ((i - 1, j, "u"), (i, j - 1, "v")):
+                if pi >= 0 and pj >= 0 and cost[pi][pj] + here < cost[i][j]:
+                    cost[i][j], came[i][j] = cost[pi][pj] + here, step
+    if cost[m][n] == inf or came[m][n] != "v":
+        return None
+    tris, i, j = [], m, n
+    while (i, j) != (0, 0):
+        if came[i][j] == "u":
+            tris.append((u(i - 1), u(i), v(j)))
+            i -= 1
+        else:
+            tris.append((v(j), v(j - 1), u(i)))
+            j -= 1
+    return cost[m][n], tris[::-1]
+
+
+TUNNEL_STYLES = ("embedded", "legacy")
+
+
+def tiling(ls, joined_pair=None, config=None, joined=None, tunnels="embedded"):
+    assert tunnels in TUNNEL_STYLES
     interior, tris = [], []
     edges = [[e for e, _ in l] for l in ls]
     for idx, l in enumerate(edges):
         if joined_pair and idx in joined_pair:
             continue
         tris += disc(l, interior)
-    if joined_pair:
+    if joined_pair and tunnels == "legacy":
+        tris += legacy_tube(config, joined, ls, joined_pair)
+    elif joined_pair:
         tris += tube(config, joined, ls, joined_pair, interior)
     return tris, interior
 
 
-def check_tiling(config, ls, tris, interior, context):
+def face_of_edges(a, b):
+    """The face holding the crossings on cube edges a and b, or None."""
+    common = set(edge_faces(a)) & set(edge_faces(b))
+    return common.pop() if common else None
+
+
+def check_tiling(config, ls, tris, interior, context, band_faces=(), tubes=0):
+    """`band_faces`: faces a legacy tube may lie in (legacy_bands); everywhere else, and always in
+    the embedded style, no triangle edge lies in a face unless it is an arc. `tubes`: loops joined
+    in pairs, each pair an annulus (Euler characteristic 0), every other loop a disc (1)."""
     crossed = {e for e in range(12) if ((config >> EDGE_CORNERS[e][0]) & 1) != ((config >> EDGE_CORNERS[e][1]) & 1)}
     directed = {}
     for t in tris:
@@ -350,7 +469,10 @@ def check_tiling(config, ls, tris, interior, context):
             directed[a, b] = True
             if a < 12 and b < 12 and share_face(a, b):
                 on_arc = any((a, b) == (l[i][0], l[(i + 1) % len(l)][0]) for l in ls for i in range(len(l)))
-                assert on_arc, ("triangle edge inside a face is not a face arc", context, a, b)
+                assert on_arc or face_of_edges(a, b) in band_faces, ("triangle edge inside a face is not a face arc", context, a, b)
+    undirected = {(min(a, b), max(a, b)) for a, b in directed}
+    euler = len({v for t in tris for v in t}) - len(undirected) + len(tris)
+    assert euler == len(ls) - 2 * tubes, ("not discs and tubes", context, euler)
     arcs = {(l[i][0], l[(i + 1) % len(l)][0]) for l in ls for i in range(len(l))}
     for (a, b) in directed:
         if (b, a) not in directed:
@@ -378,7 +500,9 @@ def self_test_orientation():
 
 # ---------------------------------------------------------------- the variant table
 
-def variants():
+def variants(tunnels="embedded"):
+    """Every (configuration, face decisions) with its tilings; `tunnels` (TUNNEL_STYLES) chooses
+    how tubes are built (see the module's docstring)."""
     out = []  # per config: list of dicts, indexed by compact face bits
     for config in range(256):
         amb = ambiguous_faces(config)
@@ -390,7 +514,7 @@ def variants():
             name = label(config, joined, ls)
             v = {"config": config, "joined": joined, "base": base, "test": TEST_NONE,
                  "axis": 0, "corner": 0, "lw_axis": 0, "lw_corner": 0, "lw_edge": 0,
-                 "lewiner": 0, "tilings": [tiling(ls)]}
+                 "lewiner": 0, "tilings": [tiling(ls)], "pairs": [None]}
             v["subcase"] = SUB[name] if name in SUB else SUB[name + ".1"]
             if name in ("4.1", "6.1", "7.4", "10.1", "12.1"):
                 (i, j, ri, rj), = tube_pairs(config, joined, ls)
@@ -398,7 +522,8 @@ def variants():
                 axis = test_axis(base, config)
                 v.update(test=TEST_TUNNEL, axis=axis, corner=p)
                 v["tunnel_subcase"] = SUB[name + ".2"]
-                v["tilings"].append(tiling(ls, (i, j), config, joined))
+                v["tilings"].append(tiling(ls, (i, j), config, joined, tunnels))
+                v["pairs"].append((i, j))
                 # mc33-lewiner: t_alt from the first crossed edge among P->P^u, P->P^v, P->P^w
                 P = v["corner"]
                 u, w_ = [a for a in range(3) if a != axis]
@@ -431,8 +556,9 @@ def variants():
                 v["tunnel_subcase"] = SUB["13.5.2"]
                 cap_loop = lambda corner: next(i for i, l in enumerate(ls) if all(corner in EDGE_CORNERS[e] for e, _ in l))
                 hexa = next(i for i, l in enumerate(ls) if len(l) == 6)
-                v["tilings"].append(tiling(ls, (cap_loop(s_plus), hexa), config, joined))   # tunnel faces s_plus
-                v["tilings"].append(tiling(ls, (cap_loop(s_minus), hexa), config, joined))  # tunnel faces s_minus
+                for cap in (s_plus, s_minus):  # tiling 1: the tunnel faces s_plus; tiling 2: s_minus
+                    v["tilings"].append(tiling(ls, (cap_loop(cap), hexa), config, joined, tunnels))
+                    v["pairs"].append((cap_loop(cap), hexa))
                 # Lewiner's route (Custodio et al., Appendix A): along x from the isolated above
                 # corner (lewiner_corner = s_plus, which decide() also reads as that corner), t_alt
                 # where the field crosses the x edge leaving it.
@@ -440,13 +566,17 @@ def variants():
                 v["lewiner"] = LEWINER_T_ALT  # condition (iii) at t_alt, orientation never tested
                 v["lw_edge"] = [e for e, (a, b) in enumerate(EDGE_CORNERS) if {a, b} == {s_plus, s_plus ^ 1}][0]
             for t, (tris, interior) in enumerate(v["tilings"]):
-                check_tiling(config, ls, tris, interior, (config, joined, name, t))
+                pair = v["pairs"][t]
+                bands = [f for f, _, _ in legacy_bands(config, joined, ls, pair)] if pair and tunnels == "legacy" else []
+                if pair and tunnels == "legacy":
+                    assert not interior, ("a legacy tube has no interior vertex", config, joined)
+                check_tiling(config, ls, tris, interior, (config, joined, name, t, tunnels), bands, 1 if pair else 0)
             per.append(v)
         out.append(per)
     return out
 
 
-def emit(table):
+def emit(table, legacy):
     tri_codes, interior_masks, rows, offsets = [], [], [], [0]
     for per in table:
         for v in per:
@@ -460,6 +590,23 @@ def emit(table):
                 tl.append((0, 0, 0, 0))
             rows.append((v, tl))
         offsets.append(offsets[-1] + len(per))
+    # the legacy set: tilings equal to the embedded ones point at them, the others (the tubes)
+    # are appended, so the embedded tables above are the same with or without this set
+    legacy_rows = []
+    for (v, tl), w in zip(rows, [w for per in legacy for w in per]):
+        assert (v["config"], v["joined"]) == (w["config"], w["joined"])
+        lt = []
+        for t, (tris, interior) in enumerate(w["tilings"]):
+            if (tris, interior) == v["tilings"][t]:
+                lt.append(tl[t])
+                continue
+            lt.append((len(tris), len(interior), len(tri_codes) // 3, len(interior_masks)))
+            for x in tris:
+                tri_codes.extend(x)
+            interior_masks.extend(interior)
+        while len(lt) < 3:
+            lt.append((0, 0, 0, 0))
+        legacy_rows.append((w, lt))
     p = print
     p("// GENERATED by tools/gen_tables/gen_tables.py. Do not edit: change the generator and run")
     p("//   python3 tools/gen_tables/gen_tables.py > src/tables/mc33_tables.cpp")
@@ -500,6 +647,16 @@ def emit(table):
             "".join(str(f) for f in range(6) if (v["joined"] >> f) & 1) or "-", SUBCASES[v["subcase"]]))
     p("};")
     p("")
+    p("// The same variants with Chernyaev's tubes (tunnels=\"legacy\"): only the tube tilings differ.")
+    p(f"const Variant kLegacyVariants[{len(legacy_rows)}] = {{")
+    for v, tl in legacy_rows:
+        t = ", ".join("{%d, %d, %d, %d}" % x for x in tl)
+        p("    {%d, %d, %d, %d, %d, %d, %d, %d, %d, {%s}}, // %d/%s" % (
+            v["subcase"], v.get("tunnel_subcase", v["subcase"]), v["test"], v["axis"], v["corner"],
+            v["lw_axis"], v["lw_corner"], v["lw_edge"], v["lewiner"], t, v["config"],
+            "".join(str(f) for f in range(6) if (v["joined"] >> f) & 1) or "-"))
+    p("};")
+    p("")
     p(f"const std::uint8_t kTriangleCodes[{len(tri_codes)}] = {{")
     for i in range(0, len(tri_codes), 24):
         p("    " + ", ".join(str(x) for x in tri_codes[i:i + 24]) + ",")
@@ -516,5 +673,5 @@ def emit(table):
 
 if __name__ == "__main__":
     self_test_orientation()
-    stats = emit(variants())
+    stats = emit(variants("embedded"), variants("legacy"))
     print("gen_tables: %d variants, %d triangles, %d interior vertices" % stats, file=sys.stderr)

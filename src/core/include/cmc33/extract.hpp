@@ -1,8 +1,10 @@
 #pragma once
 /// @file extract.hpp
 /// The isosurface extractor: Marching Cubes 33 with the corrections of Custodio, Etiene, Pesco and
-/// Silva 2013 (method `cmc33`), and for comparison the earlier MC33 (`mc33-lewiner`) and classic
-/// Marching Cubes (`mc`). One code path; only the decision policy differs.
+/// Silva 2013 (method `cmc33`), and for comparison the methods that paper compares: Chernyaev's
+/// MC33 (`chernyaev`), Lewiner et al.'s (`mc33-lewiner`), the paper's own C-MC33 (`cmc33-paper`)
+/// and classic Marching Cubes (`mc`). One code path; the decision policy and the table set are
+/// chosen per call.
 
 #include <array>
 #include <cstdint>
@@ -15,13 +17,23 @@
 
 namespace cmc33 {
 
+/// The methods of Custodio et al. 2013 (C13). Two table sets (src/tables/mc33_tables.hpp): embedded
+/// tubes (cmc33, mc) and Chernyaev's tubes, which lie in a cell face where they cross an ambiguous
+/// one, so that two neighbouring tunnels through one face give non-manifold edges (C13 Sec. 5.2;
+/// chernyaev, mc33-lewiner, cmc33-paper).
 enum class Method {
-    cmc33,        ///< default: topologically correct and manifold
-    mc33_lewiner, ///< MC33 with the flaws the 2013 paper describes (t_alt, case 10/12 branch, 13.5)
+    cmc33,        ///< default: C13's decisions, embedded tubes: topologically correct, manifold, embedded
+    mc33_lewiner, ///< Lewiner et al. 2003: t_alt for cases 6, 7, 12, 13 (C13 Issue III), no joined
+                  ///< branch of cases 10 and 12 (Issue IV), 13.5 by condition (iii) (Issue I); Chernyaev's tubes
     mc,           ///< classic Marching Cubes: one triangulation per sign configuration
+    chernyaev,    ///< Chernyaev 1995: t_max and his three conditions everywhere, 13.5 included (C13
+                  ///< Issue I), Algorithm 2 complete; his tubes (Issue II)
+    cmc33_paper,  ///< C13's C-MC33: cmc33's decisions, Chernyaev's tubes, and the grid refinement of
+                  ///< C13 Sec. 6.2 wherever two tunnels share an ambiguous face (extract() only)
 };
 
-CMC33_CORE_EXPORT std::string_view method_name(Method method) noexcept; ///< "cmc33", "mc33-lewiner", "mc"
+/// "cmc33", "mc33-lewiner", "mc", "chernyaev", "cmc33-paper"
+CMC33_CORE_EXPORT std::string_view method_name(Method method) noexcept;
 /// @throws Error{invalid_argument} naming the accepted names.
 CMC33_CORE_EXPORT Method parse_method(std::string_view name);
 
@@ -54,9 +66,16 @@ struct ExtractOptions {
 
 struct ExtractStats {
     std::array<std::int64_t, kSubcaseCount> cells_per_subcase{}; ///< cells the surface crosses
+    std::int64_t refinement_planes = 0; ///< cmc33_paper: sample planes added (C13 Sec. 6.2); else 0
 };
 
-/// Extracts S = {x : f(x) = iso}, f the trilinear interpolant of the samples.
+/// Extracts S = {x : f(x) = iso}, f the trilinear interpolant of the samples.///
+/// Method cmc33_paper first looks for pairs of neighbouring cells whose (Chernyaev) tubes both lie
+/// in the face they share; while there are any, it splits the slab of cells holding each such face
+/// by a plane through the face's saddle point (C13 Sec. 6.2, Fig. 11: the interpolant is unchanged,
+/// the face's ambiguity is gone) and looks again; then it extracts from the refined grid. Its
+/// vertices therefore include points on the added planes, and `stats` counts the refined cells.
+
 ///
 /// Sign rule: a sample (or face or interior saddle) equal to iso counts as above it.
 /// One vertex per crossed grid edge, shared by every cell around that edge; cells whose subcase

@@ -88,6 +88,9 @@ struct MethodReport {
     std::int64_t checked = 0;      ///< fields compared (determined ones)
     std::int64_t matched = 0;      ///< invariants equal, manifold and embedded (also once welded)
     std::int64_t mismatched = 0;   ///< checked - matched (includes non-manifold and errors)
+    /// meshes whose invariants (euler, b0, b1, b2, boundary loops, by index) differ from the
+    /// field's: the topology claims of Custodio et al. 2013, apart from manifoldness and geometry
+    std::int64_t topology_mismatched = 0;
     std::int64_t undetermined = 0; ///< fields field_topology could not settle: not compared
     std::int64_t nonmanifold = 0;  ///< meshes with a non-manifold edge or vertex
     std::int64_t unoriented = 0;   ///< meshes not consistently oriented (reported, not a mismatch)
@@ -97,11 +100,17 @@ struct MethodReport {
     std::int64_t errors = 0;       ///< extract threw, or the command failed (also mismatched)
     std::array<std::int64_t, kFieldKindCount> checked_by_kind{};
     std::array<std::int64_t, kFieldKindCount> mismatched_by_kind{};
+    std::array<std::int64_t, kFieldKindCount> topology_mismatched_by_kind{};
     /// Per subcase: fields that contain it, and of those the mismatching ones. A cell counts for
     /// the subcase the method assigns it (analyze_cell); a grid counts for every subcase with a
     /// face or interior test (3.x 4.x 6.x 7.x 10.x 12.x 13.x) that occurs among its cells.
     std::array<std::int64_t, kSubcaseCount> fields_per_subcase{};
     std::array<std::int64_t, kSubcaseCount> mismatches_per_subcase{};
+    std::array<std::int64_t, kSubcaseCount> topology_mismatches_per_subcase{}; ///< of those, topology_mismatched
+    /// The same for single cells alone, where a mismatch points at one decision: cells per
+    /// subcase (as the method classifies them) and those whose topology mismatched.
+    std::array<std::int64_t, kSubcaseCount> cells_per_subcase{};
+    std::array<std::int64_t, kSubcaseCount> cell_topology_mismatches_per_subcase{};
     std::int64_t failures_written = 0; ///< failing fields saved for this method
     /// "cell-000001: why": the first field (in run order) that gave no mesh, among the
     /// max_failures kept; "" if none. Set whether or not failures are written.
