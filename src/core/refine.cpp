@@ -22,7 +22,12 @@
 
 #include "refine.hpp"
 
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
 #include <gmpxx.h>
+#else
+#include "cmc33/error.hpp"
+#include "expansion.hpp"
+#endif
 
 #include <algorithm>
 #include <array>
@@ -105,8 +110,19 @@ double interpolate(double a, double b, double s, double iso)
     // three roundings of at most 2^-53 of numbers below |a| + |b| each, and one more in r - iso
     const double bound = 0x1p-50 * (std::fabs(a) + std::fabs(b) + std::fabs(iso)) + std::numeric_limits<double>::denorm_min();
     if (std::fabs(r - iso) > bound) return r;
+#if !defined(CMC33_WITH_GMP) || CMC33_WITH_GMP
     const mpq_class exact = mpq_class(a) + mpq_class(s) * (mpq_class(b) - mpq_class(a)) - mpq_class(iso);
     const int side = sgn(exact);
+#else
+    // without GMP (the WebAssembly build): the same sum in Shewchuk expansions, exact unless a
+    // product underflows; then an error, never a guess
+    const Expansion exact = Expansion(a) + Expansion(s) * (Expansion(b) - Expansion(a)) - Expansion(iso);
+    if (exact.lost()) {
+        throw Error(Status::internal, "cmc33-paper: a refined sample within rounding of the isovalue needs exact arithmetic "
+                                      "beyond this build's range; a build with GMP decides it");
+    }
+    const int side = exact.sign();
+#endif
     if (side == 0) return iso;
     if (side > 0 && !(r > iso)) return std::nextafter(iso, std::numeric_limits<double>::infinity());
     if (side < 0 && !(r < iso)) return std::nextafter(iso, -std::numeric_limits<double>::infinity());
