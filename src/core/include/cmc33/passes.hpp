@@ -24,11 +24,10 @@
 /// offsets.first_vertex + counts.vertex_count().
 ///
 /// The composition over any split, with any offsets, gives the same bytes as extract() shifted by
-/// the offsets (tests/core/test_passes.cpp). emit places the vertices and triangles of count's
-/// classification and decisions (kept in RangeCounts): it refuses counts of another grid, isovalue
-/// or method, and checks that it writes exactly what count counted (Error{internal} otherwise,
-/// before writing outside the range's part). The samples must not change between the passes: if
-/// they do, emit still writes count's mesh inside the given spans, at the new samples' positions.
+/// the offsets (tests/core/test_passes.cpp). emit replays count's decisions (kept in RangeCounts)
+/// and classifies the samples again: it refuses counts of another grid, isovalue or method, and
+/// checks that it writes exactly what count counted (Error{internal} otherwise, before writing
+/// outside the range's part). The samples must not change between the passes.
 
 #include <cstdint>
 #include <functional>
@@ -42,10 +41,8 @@
 namespace cmc33 {
 
 /// What count() found in one range: the number of vertices and triangles, and per sample row the
-/// numbers emit() needs to place them. Opaque apart from the accessors; per sample row 28 bytes and,
-/// for rows with samples on both sides of iso, its above-flags (a bit per sample); one byte per
-/// cell with a face or interior test (its decision): emit() uses count()'s classification and
-/// decisions instead of making them again.
+/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row and
+/// one per cell with a face or interior test (its decision, which emit() replays).
 class RangeCounts {
 public:
     std::int64_t k0() const noexcept { return k0_; }
@@ -80,12 +77,6 @@ private:
     /// One byte per cell with a face or interior test, in the order count met them: its decision,
     /// which emit replays instead of deciding again
     std::vector<std::uint8_t> decisions_;
-    /// What count classified, for emit: per sample row of planes k0 .. min(k1, nz - 1) its kind
-    /// (kRowBelow, kRowAbove) or, for a row whose samples lie on both sides, where its above-flags
-    /// ((nx + 63) / 64 + 1 words) start in flags_, in rows
-    std::vector<std::uint32_t> flag_rows_;
-    std::vector<std::uint64_t> flags_;
-    static constexpr std::uint32_t kRowBelow = 0xffffffffu, kRowAbove = 0xfffffffeu;
     ExtractStats stats_{};
 };
 
