@@ -44,8 +44,10 @@ CASES = {
     "sphere": ("work:sphere", 0.0, "distance field: one smooth sphere, few cells crossed"),
     "sines": ("work:sines", 0.25, "a large smooth surface over the whole grid"),
     "noise": ("work:noise", 0.0, "the worst case: nearly every cell crossed, most ambiguous"),
+    "ties": ("work:ties", 80.0, "{60, 80, 100} as float32 at iso 80: ties everywhere, exact decisions"),
+    "ties-u8": ("work:ties-u8", 80.0, "the same numbers as uint8"),
 }
-SIZES = {"sphere": (256, 64), "sines": (512, 128), "noise": (128, 64)}  # full, --quick
+SIZES = {"sphere": (256, 64), "sines": (512, 128), "noise": (128, 64), "ties": (128, 64), "ties-u8": (128, 64)}  # full, --quick
 TYPE_BYTES = {"int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "float": 4, "double": 8}
 
 
@@ -164,7 +166,8 @@ def main(argv):
             kind = CASES[c][0][5:]
             n = SIZES[kind][1 if args.quick else 0]
             print(f"{PROG}: making {f}", file=sys.stderr)
-            if subprocess.run([make_field, kind, f, str(n)]).returncode != 0:
+            field = ["ties", f, str(n), "--uint8"] if kind == "ties-u8" else [kind, f, str(n)]
+            if subprocess.run([make_field] + field).returncode != 0:
                 die(f"cmc33_make_field could not write {f}")
 
     # ---- the runs ------------------------------------------------------------------------
@@ -331,6 +334,10 @@ def tables(records, cases, meta, notes):
               "cold (at the bandwidth of a buffer larger than the caches); cmc33 1t / cold floor is how many "
               "such reads the extraction takes. Peak MiB: the whole process (GNU time %M), the Python "
               "interpreter and its modules included for VTK and scikit-image. bench/README.md has the details."]
+    tf, tu = find("ties", "cmc33", 1), find("ties-u8", "cmc33", 1)
+    if tf and tu and "seconds" in tf and "seconds" in tu:
+        lines += ["", f"Ties: cmc33 on the float32 ties field takes {tf['seconds'] / tu['seconds']:.2f}x its time on the "
+                      "same numbers as uint8 (one thread, normals)."]
     notes = notes + [f"failed: {f}" for f in failures]
     if notes:
         lines += ["", "Notes:", ""] + [f"- {n}" for n in notes]

@@ -56,6 +56,25 @@ inline Volume make_noise(std::int64_t n, std::uint64_t seed)
     return volume;
 }
 
+/// n^3 samples drawn from {60, 80, 100} by std::mt19937_64(seed), as uint8 or as float32: at iso
+/// 80 every third sample is a tie and most cells are ambiguous, the case where exact decisions work
+/// hardest; the two types hold the same numbers, so their times compare the decisions' paths.
+inline Volume make_ties(std::int64_t n, std::uint64_t seed, bool as_float)
+{
+    Volume volume(as_float ? ScalarType::f32 : ScalarType::u8, {n, n, n});
+    std::mt19937_64 random(seed);
+    const std::int64_t count = volume.sample_count();
+    for (std::int64_t i = 0; i < count; ++i) {
+        const int value = 60 + 20 * static_cast<int>(random() % 3);
+        if (as_float) {
+            volume.samples<float>()[i] = static_cast<float>(value);
+        } else {
+            volume.samples<std::uint8_t>()[i] = static_cast<std::uint8_t>(value);
+        }
+    }
+    return volume;
+}
+
 /// The distance to the grid's centre minus N / 3: at iso 0 one sphere, a smooth surface crossing
 /// few cells of a large grid.
 inline Volume make_sphere(std::int64_t n)
