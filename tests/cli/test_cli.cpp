@@ -27,6 +27,7 @@
 #include "cmc33/io.hpp"
 #include "cmc33/version.hpp"
 #include "cmc33/volume.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace cmc33 {
@@ -35,54 +36,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Result {
-    int code = -1;
-    std::string out;
-    std::string err;
-};
-
-std::string quote(const std::string& s)
-{
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-/// Runs `cmc33 ARGS` through the shell: stdout through a pipe, stderr through a file. `shell`
-/// comes before the command on the same line ("cd DIR && ", "ulimit -f 1; exec ").
-Result run(const std::string& args, const std::string& shell = "")
-{
-    static int counter = 0;
-    const fs::path err_file = fs::temp_directory_path() /
-                              ("cmc33-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".err");
-    const std::string command =
-        "{ " + shell + quote(CMC33_EXE) + " " + args + "; } 2>" + quote(err_file.string()) + " </dev/null";
-    Result r;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) {
-        ADD_FAILURE() << "popen failed for " << command;
-        return r;
-    }
-    char buffer[4096];
-    std::size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
-    const int status = ::pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.err = test::read_file(err_file);
-    fs::remove(err_file);
-    return r;
-}
-
-/// Parses stdout as one JSON value; a failure is reported with the text.
-json parse(const Result& r)
-{
-    try {
-        return json::parse(r.out);
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "stdout is not JSON (" << e.what() << "):\n" << r.out;
-        return json::object();
-    }
-}
+using test::cli::parse;
+using test::cli::quote;
+using test::cli::Result;
+using test::cli::run;
 
 /// The error contract: exit 1, one line "cmc33: ..." on stderr naming `name`, nothing on stdout.
 void expect_failure(const Result& r, const std::string& name)

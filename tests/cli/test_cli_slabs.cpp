@@ -19,6 +19,7 @@
 
 #include "cmc33/io.hpp"
 #include "cmc33/volume.hpp"
+#include "cli_run.hpp"
 #include "test_support.hpp"
 
 namespace cmc33 {
@@ -27,47 +28,10 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-struct Result {
-    int code = -1;
-    std::string out, err;
-};
-
-std::string quote(const std::string& s)
-{
-    std::string q = "'";
-    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
-    return q + "'";
-}
-
-/// `cmc33 ARGS`: stdout through a pipe, stderr through a file.
-Result run(const std::string& args)
-{
-    static int counter = 0;
-    const fs::path err = fs::temp_directory_path() / ("cmc33-slabs-test-" + std::to_string(::getpid()) + "-" +
-                                                      std::to_string(counter++) + ".err");
-    const std::string command = "{ " + quote(CMC33_EXE) + " " + args + "; } 2>" + quote(err.string()) + " </dev/null";
-    Result r;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (pipe == nullptr) return r;
-    char buffer[4096];
-    std::size_t n;
-    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
-    const int status = ::pclose(pipe);
-    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.err = test::read_file(err);
-    fs::remove(err);
-    return r;
-}
-
-json parse(const Result& r)
-{
-    try {
-        return json::parse(r.out);
-    } catch (const std::exception& e) {
-        ADD_FAILURE() << "stdout is not JSON (" << e.what() << "): " << r.out << r.err;
-        return json::object();
-    }
-}
+using test::cli::parse;
+using test::cli::quote;
+using test::cli::Result;
+using test::cli::run;
 
 /// The keys that do not depend on time, threads or the limit.
 void expect_same_json(const json& a, const json& b, const std::string& what)

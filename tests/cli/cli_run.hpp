@@ -1,0 +1,71 @@
+#pragma once
+// Running the command-line tool from a test: `cmc33 ARGS` through the shell, stdout through a pipe,
+// stderr through a file, and stdout parsed as JSON. Shared by the CLI's test executables, each of
+// which defines CMC33_EXE (the tool's path) for itself.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "test_support.hpp"
+
+namespace cmc33::test::cli {
+
+struct Result {
+    int code = -1;
+    std::string out;
+    std::string err;
+};
+
+/// `s` as one single-quoted shell word.
+inline std::string quote(const std::string& s)
+{
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+/// Runs `cmc33 ARGS` through the shell: stdout through a pipe, stderr through a file, no standard
+/// input. `shell` comes before the command on the same line ("cd DIR && ", "ulimit -f 1; exec ").
+inline Result run(const std::string& args, const std::string& shell = "")
+{
+    namespace fs = std::filesystem;
+    static int counter = 0;
+    const fs::path err_file = fs::temp_directory_path() /
+                              ("cmc33-cli-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++) + ".err");
+    const std::string command =
+        "{ " + shell + quote(CMC33_EXE) + " " + args + "; } 2>" + quote(err_file.string()) + " </dev/null";
+    Result r;
+    FILE* pipe = ::popen(command.c_str(), "r");
+    if (pipe == nullptr) {
+        ADD_FAILURE() << "popen failed for " << command;
+        return r;
+    }
+    char buffer[4096];
+    std::size_t n;
+    while ((n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0) r.out.append(buffer, n);
+    const int status = ::pclose(pipe);
+    r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = test::read_file(err_file);
+    fs::remove(err_file);
+    return r;
+}
+
+/// Parses stdout as one JSON value; a failure is reported with the text (and an empty object).
+inline nlohmann::json parse(const Result& r)
+{
+    try {
+        return nlohmann::json::parse(r.out);
+    } catch (const std::exception& e) {
+        ADD_FAILURE() << "stdout is not JSON (" << e.what() << "):\n" << r.out << r.err;
+        return nlohmann::json::object();
+    }
+}
+
+} // namespace cmc33::test::cli
