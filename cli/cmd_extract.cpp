@@ -127,16 +127,7 @@ void add_extract(CLI::App& app)
                     "Read the volume and write the mesh slab by slab within SIZE bytes (256M, 2G): for "
                     "volumes and meshes larger than memory; binary .ply only, same bytes")
         ->type_name("SIZE")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                try {
-                    (void)slabs_size(text);
-                    return {};
-                } catch (const Error& e) {
-                    return e.what();
-                }
-            },
-            "SIZE", "size"));
+        ->check(memory_size());
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT, extracts the triangle mesh of the isosurface at ISO with Marching Cubes 33\n"

@@ -366,16 +366,7 @@ void add_info(CLI::App& app)
     cmd->add_option("--memory-limit", args->memory_limit,
                     "Read the volume a few planes at a time within SIZE bytes (256M, 2G); the same output")
         ->type_name("SIZE")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                try {
-                    (void)slabs::parse_size(text);
-                    return {};
-                } catch (const Error& e) {
-                    return e.what();
-                }
-            },
-            "SIZE", "size"));
+        ->check(cli::memory_size());
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT and prints its dimensions, sample type, spacing and origin (and the axis\n"

@@ -20,6 +20,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
+#include "slabs.hpp"
 
 namespace cmc33::cli {
 
@@ -211,6 +212,20 @@ CLI::Validator non_empty(const std::string& what)
 }
 
 CLI::Validator thread_count() { return whole_number(0, kMaxThreads); }
+
+CLI::Validator memory_size()
+{
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            try {
+                (void)slabs::parse_size(text);
+                return {};
+            } catch (const Error& e) {
+                return e.what();
+            }
+        },
+        "SIZE", "size");
+}
 
 namespace {
 

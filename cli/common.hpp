@@ -73,6 +73,8 @@ CLI::Validator non_empty(const std::string& what);
 inline constexpr std::int64_t kMaxThreads = 1024;
 /// --threads N: 0 (all cores) to kMaxThreads.
 CLI::Validator thread_count();
+/// --memory-limit SIZE: bytes, or a whole number with k, M, G or T (slabs::parse_size's message).
+CLI::Validator memory_size();
 
 /// Installs the cleanup of temporaries on SIGINT, SIGTERM and SIGHUP (cli/signals.cpp). Call
 /// first in main(), before any thread starts.

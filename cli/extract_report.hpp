@@ -51,7 +51,5 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& report);
 /// `cmc33 extract --memory-limit`: the volume read and the mesh written slab by slab.
 void run_extract_slabs(const ExtractArgs& args);
 
-/// The bytes of a --memory-limit value ("256M"). @throws Error{invalid_argument}
-std::uint64_t slabs_size(const std::string& text);
 
 } // namespace cmc33::cli

@@ -62,7 +62,6 @@ std::int64_t peak_rss_bytes()
 
 } // namespace
 
-std::uint64_t slabs_size(const std::string& text) { return slabs::parse_size(text); }
 
 void run_extract_slabs(const ExtractArgs& args)
 {

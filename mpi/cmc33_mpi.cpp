@@ -456,16 +456,7 @@ void add_extract(CLI::App& app, ExtractArgs& args)
     cmd->add_option("--memory-limit", args.memory_limit,
                     "Per rank: read the rank's planes and write its mesh slab by slab within SIZE bytes (256M, 2G)")
         ->type_name("SIZE")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                try {
-                    (void)slabs::parse_size(text);
-                    return {};
-                } catch (const Error& e) {
-                    return e.what();
-                }
-            },
-            "SIZE", "size"));
+        ->check(cli::memory_size());
     auto* progress = cmd->add_flag("--progress", args.progress, "Progress lines of rank 0 on stderr even when it is not a terminal");
     cmd->add_flag("--quiet", args.quiet, "No progress line")->excludes(progress);
     cli::add_raw_volume_options(*cmd, args.raw);
