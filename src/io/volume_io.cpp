@@ -425,17 +425,28 @@ std::size_t parse_ascii_samples(std::string_view text, Volume& volume, const std
     });
 }
 
-std::uint64_t check_raw_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
-                                const std::string& label)
+namespace {
+
+/// The bytes of a file of `size` bytes after the samples' offset.
+/// @throws Error{truncated_file} when the offset lies beyond the end
+std::uint64_t bytes_after_offset(std::uint64_t size, const Storage& storage, const std::string& label)
 {
-    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
-    const std::uint64_t size = file.size();
     if (storage.offset > size) {
         throw Error(Status::truncated_file,
                     str_cat(label, ": the samples should start at byte ", storage.offset,
                             " but the file has only ", size, " bytes (file cut short?)"));
     }
-    const std::uint64_t available = size - storage.offset;
+    return size - storage.offset;
+}
+
+} // namespace
+
+std::uint64_t check_raw_samples(const ByteInput& file, const Grid& grid, const Storage& storage,
+                                const std::string& label)
+{
+    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
+    const std::uint64_t size = file.size();
+    const std::uint64_t available = bytes_after_offset(size, storage, label);
     if (available < bytes) {
         throw Error(Status::truncated_file,
                     str_cat(label, ": ", declared(grid, bytes), " but only ", available,
@@ -456,12 +467,7 @@ std::uint64_t check_compressed_samples(const ByteInput& file, const Grid& grid, 
 {
     const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
     const std::uint64_t size = file.size();
-    if (storage.offset > size) {
-        throw Error(Status::truncated_file,
-                    str_cat(label, ": the samples should start at byte ", storage.offset,
-                            " but the file has only ", size, " bytes (file cut short?)"));
-    }
-    const std::uint64_t available = size - storage.offset;
+    const std::uint64_t available = bytes_after_offset(size, storage, label);
     std::uint64_t stream = available;
     if (storage.stored_size) {
         if (*storage.stored_size > available) {
@@ -502,12 +508,7 @@ Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& stor
 {
     const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
     const std::uint64_t size = file.size();
-    if (storage.offset > size) {
-        throw Error(Status::truncated_file,
-                    str_cat(label, ": the samples should start at byte ", storage.offset,
-                            " but the file has only ", size, " bytes (file cut short?)"));
-    }
-    const std::uint64_t available = size - storage.offset;
+    const std::uint64_t available = bytes_after_offset(size, storage, label);
     const std::size_t width = type_size(grid.type);
 
     switch (storage.encoding) {
