@@ -1,8 +1,10 @@
 // cmc33.marching_cubes's extraction: count, scan and emit (cmc33/passes.hpp) over ranges of sample
-// planes, the ranges taken by `threads` threads in turn. Each range, once emitted and while its
-// vertices are in cache, gets its values, its winding and its coordinates in the array's axis
-// order. A mask then drops the triangles of masked cells and the vertices no kept triangle uses,
-// in place.
+// planes, the ranges taken by `threads` threads in turn. emit writes the array's axis order, the
+// winding of gradient_direction and scikit-image's values itself (MeshSpans::zyx,
+// reverse_winding, vertex_cell_ranges). With a mask, values count only the kept cells: each range,
+// once emitted and while its triangles are in cache, gets its values from its triangles' cells
+// and marks the masked cells' triangles; then those triangles and the vertices no kept triangle
+// uses are dropped, in place.
 
 #include "drop_in.hpp"
 
@@ -96,12 +98,16 @@ public:
         m.vertex_count = nv;
         m.triangle_count = nt;
         std::vector<std::vector<SeamValue>> seams(static_cast<std::size_t>(ranges));
-        // per thread, the cells of its range's triangles, reused from range to range (fresh
-        // memory for every range would cost a page fault per 4 KiB of it)
-        std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(n));
+        // with a mask, per thread, the cells of its range's triangles, reused from range to range
+        // (fresh memory for every range would cost a page fault per 4 KiB of it)
+        std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(o_.mask ? n : 0));
         run_ranges(n, ranges, control, 0.5, 0.5, [&](int r, int thread) {
             const auto i = static_cast<std::size_t>(r);
-            emit_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);
+            if (o_.mask) {
+                emit_masked_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);
+            } else {
+                emit(g_, iso_, options_, counts[i], offsets[i], spans(m, offsets[i]));
+            }
         });
         for (const std::vector<SeamValue>& seam : seams)
             for (const SeamValue& s : seam) m.values[s.vertex] = std::max(m.values[s.vertex], s.value);
@@ -116,23 +122,38 @@ private:
         float value;
     };
 
-    /// Emits one range into m and finishes its part: values, winding, masked triangles marked
-    /// (triangles run cell by cell: each cell's range is computed once).
-    void emit_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, Buffer<std::int64_t>& cells,
-                    std::vector<SeamValue>& seam) const
+    /// Where emit writes the range at `at` of m: positions and normals in the array's axis order,
+    /// triangles wound as gradient_direction says; without a mask also the values.
+    MeshSpans spans(DropInMesh& m, const RangeOffsets& at) const
+    {
+        const auto fv = static_cast<std::size_t>(at.first_vertex);
+        const auto ft = static_cast<std::size_t>(at.first_triangle);
+        MeshSpans out;
+        out.positions = m.positions.data() + 3 * fv;
+        out.normals = m.normals.data() + 3 * fv;
+        out.triangles = m.triangles.data() + 3 * ft;
+        if (!o_.mask) out.vertex_cell_ranges = m.values.data() + fv;
+        out.zyx = true;
+        // extract()'s triangles wind counter-clockwise around the normals in (x, y, z); written as
+        // (z, y, x), a mirror image, they wind clockwise: scikit-image's 'descent'
+        out.reverse_winding = !o_.descent;
+        out.first_vertex = at.first_vertex;
+        out.first_triangle = at.first_triangle;
+        return out;
+    }
+
+    /// Emits one range into m with a mask and finishes its part: values from the kept cells,
+    /// masked triangles marked.
+    void emit_masked_range(const RangeCounts& c, const RangeOffsets& at, DropInMesh& m, Buffer<std::int64_t>& cells,
+                           std::vector<SeamValue>& seam) const
     {
         const auto fv = static_cast<std::size_t>(at.first_vertex);
         const auto ft = static_cast<std::size_t>(at.first_triangle);
         const auto nv = static_cast<std::size_t>(c.vertex_count());
         const auto nt = static_cast<std::size_t>(c.triangle_count());
         cells.resize(nt); // the range's triangles' cells (emit writes them all)
-        MeshSpans out;
-        out.positions = m.positions.data() + 3 * fv;
-        out.normals = m.normals.data() + 3 * fv;
-        out.triangles = m.triangles.data() + 3 * ft;
+        MeshSpans out = spans(m, at);
         out.triangle_cells = cells.data();
-        out.first_vertex = at.first_vertex;
-        out.first_triangle = at.first_triangle;
         emit(g_, iso_, options_, c, at, out);
 
         // scikit-image's values: per vertex, the largest range among the kept cells whose
@@ -142,24 +163,16 @@ private:
         std::fill(values + fv, values + fv + nv, 0.0f);
         // Every triangle computes its cell's range, also when the triangle before it had the same
         // cell: a branch on "same cell as before" would mispredict about every other triangle,
-        // and the samples are in cache. A dense C-ordered grid stores cell i + nx * (j + ny * k)'s
-        // lowest corner at that offset; other layouts decode the index.
+        // and the samples are in cache.
         std::uint32_t* t = m.triangles.data() + 3 * ft;
-        const bool dense = g_.strides[0] == 1 && g_.strides[1] == g_.nx() && g_.strides[2] == g_.nx() * g_.ny();
         Decoder decode(g_.nx(), g_.ny());
         for (std::size_t f = 0; f < nt; ++f, t += 3) {
-            const T* corner;
-            if (dense && !o_.mask) {
-                corner = g_.data + cells[f];
-            } else {
-                const Index3 at_cell = decode(cells[f]);
-                if (o_.mask && !(*o_.mask)(at_cell[0], at_cell[1], at_cell[2])) {
-                    t[0] = kDropped;
-                    continue;
-                }
-                corner = g_.data + g_.offset(at_cell[0], at_cell[1], at_cell[2]);
+            const Index3 at_cell = decode(cells[f]);
+            if (!(*o_.mask)(at_cell[0], at_cell[1], at_cell[2])) {
+                t[0] = kDropped;
+                continue;
             }
-            const float range = static_cast<float>(cell_range(corner));
+            const float range = static_cast<float>(cell_range(g_.data + g_.offset(at_cell[0], at_cell[1], at_cell[2])));
             for (std::size_t k = 0; k < 3; ++k) {
                 const std::uint32_t v = t[k];
                 if (v - fv < nv) {
@@ -168,12 +181,6 @@ private:
                     seam.push_back({v, range});
                 }
             }
-            if (!o_.descent) std::swap(t[1], t[2]);
-        }
-        // (x, y, z) to the array's order (z, y, x), while the range's vertices are in cache
-        for (std::size_t v = fv; v < fv + nv; ++v) {
-            std::swap(m.positions[3 * v], m.positions[3 * v + 2]);
-            std::swap(m.normals[3 * v], m.normals[3 * v + 2]);
         }
     }
 

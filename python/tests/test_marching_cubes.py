@@ -200,6 +200,34 @@ def test_step_size_reads_every_nth_sample(skimage_mc):
         cmc33.marching_cubes(volume, 120.5, step_size=100)
 
 
+@pytest.mark.parametrize("dtype", [np.int8, np.uint16, np.int32, np.float32, np.float64])
+@pytest.mark.parametrize("shape", [(2, 2, 2), (2, 3, 5), (7, 4, 3), (9, 11, 13)])
+def test_values_are_the_largest_range_of_the_cells_using_each_vertex(dtype, shape):
+    """Without a mask, emit computes values from each vertex's edge (the cells around it); with a
+    mask, from the cells of its triangles. A full mask must give the same bytes, also at the
+    grid's borders, on strided views and for both windings; and each value is checked against
+    the cells of its triangles directly."""
+    rng = np.random.default_rng(sum(shape) + np.dtype(dtype).itemsize)
+    volume = rng.integers(-100, 100, size=(2 * shape[0], shape[1], shape[2] + 1)).astype(dtype)[::2, :, 1:]
+    if np.dtype(dtype).kind == "f":
+        volume = volume * np.asarray(0.37, dtype=dtype)
+    level = float(np.median(volume)) + 0.5
+    for direction in ("descent", "ascent"):
+        whole = cmc33.marching_cubes(volume, level, gradient_direction=direction, threads=2)
+        masked = cmc33.marching_cubes(volume, level, gradient_direction=direction,
+                                      mask=np.ones(volume.shape, dtype=bool), threads=2)
+        for a, b in zip(whole, masked):
+            assert np.array_equal(a, b)
+    verts, faces, _, values = whole
+    wide = volume.astype(np.float64)
+    expected = np.zeros(len(verts))
+    for face in faces:
+        corner = np.floor(verts[face].mean(axis=0)).astype(int)  # the cell the triangle lies in
+        cell = wide[corner[0]:corner[0] + 2, corner[1]:corner[1] + 2, corner[2]:corner[2] + 2]
+        expected[face] = np.maximum(expected[face], cell.max() - cell.min())
+    assert np.array_equal(values, expected.astype(np.float32))
+
+
 def test_mask_keeps_the_cells_skimage_keeps(skimage_mc):
     volume = uint8_blobs()
     mask = np.zeros(volume.shape, dtype=bool)

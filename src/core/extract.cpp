@@ -76,6 +76,16 @@ constexpr std::array<std::uint8_t, 12> kEdgeSlot = [] {
     return s;
 }();
 
+/// For each case code, its crossed edges as a 12-bit mask (edge q crosses when its corners differ).
+constexpr std::array<std::uint16_t, 256> kCrossedEdges = [] {
+    std::array<std::uint16_t, 256> m{};
+    for (unsigned code = 0; code < 256; ++code)
+        for (int q = 0; q < 12; ++q) {
+            if (((code >> kEdgeCorners[q][0]) ^ (code >> kEdgeCorners[q][1])) & 1u) m[code] |= static_cast<std::uint16_t>(1u << q);
+        }
+    return m;
+}();
+
 /// A row's above-flags as 64-bit words (classify.hpp), with one zero word after the last so that
 /// "the flag of sample i + 1" can read one word past any sample's.
 using Word = std::uint64_t;
@@ -466,6 +476,15 @@ public:
             throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
         }
         const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
+        if (out.vertex_cell_ranges) {
+            // each cell raises the values of its edges' vertices to its range (emit_row_cells)
+            float* values = out.vertex_cell_ranges + (off.first_vertex - out.first_vertex);
+            std::fill(values, values + c.vertices_, 0.0f);
+        }
+        // the usual output (positions, triangles, maybe normals) takes code without the extras'
+        // tests, which cost 2-4 % where they are not taken
+        const bool extras = out.vertex_edges || out.vertex_parameters || out.vertex_values || out.triangle_cells ||
+                            out.vertex_cell_ranges || out.zyx || out.reverse_winding;
         Scratch s(nx_, ny_);
         std::size_t decision = 0; // the next of count's decisions
         for (std::int64_t k = k0; k < k1; ++k) {
@@ -474,9 +493,14 @@ public:
                 if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
                 std::int64_t interior = 0;
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
-                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices(j, k, ids, s, e);
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) {
+                    extras ? emit_row_vertices<true>(j, k, ids, s, e) : emit_row_vertices<false>(j, k, ids, s, e);
+                }
                 std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
-                if (r.t1 != r.t0) emit_row_cells(j, k, s, e, vertex_end, triangle_end, decision);
+                if (r.t1 != r.t0) {
+                    extras ? emit_row_cells<true>(j, k, s, e, vertex_end, triangle_end, decision)
+                           : emit_row_cells<false>(j, k, s, e, vertex_end, triangle_end, decision);
+                }
                 if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
                     throw_mismatch("vertices or triangles", j, k);
                 }
@@ -774,15 +798,83 @@ private:
         return std::clamp(16 * ulp / shortest, detail::kMinCrossing, 0.125);
     }
 
-    /// The world position of index-space point x (the frame of volume.hpp), rounded to float.
-    void write_position(const double x[3], float* out) const
+    /// The world position of index-space point x (the frame of volume.hpp), rounded to float, as
+    /// (x, y, z) or with `zyx` (MeshSpans) as (z, y, x).
+    CMC33_ALWAYS_INLINE void write_position(const double x[3], float* out, bool zyx) const
     {
+        float p[3];
         if (diagonal_) {
-            for (std::size_t c = 0; c < 3; ++c) out[c] = static_cast<float>(g_.origin[c] + step_[c] * x[c]);
-            return;
+            for (std::size_t c = 0; c < 3; ++c) p[c] = static_cast<float>(g_.origin[c] + step_[c] * x[c]);
+        } else {
+            for (std::size_t c = 0; c < 3; ++c)
+                p[c] = static_cast<float>(g_.origin[c] + (m_[c][0] * x[0] + m_[c][1] * x[1] + m_[c][2] * x[2]));
         }
-        for (std::size_t c = 0; c < 3; ++c)
-            out[c] = static_cast<float>(g_.origin[c] + (m_[c][0] * x[0] + m_[c][1] * x[1] + m_[c][2] * x[2]));
+        store(p, out, zyx);
+    }
+
+    /// out = p, or p reversed (z, y, x) with `zyx`.
+    CMC33_ALWAYS_INLINE static void store(const float p[3], float* out, bool zyx)
+    {
+        const std::size_t first = zyx ? 2 : 0;
+        out[first] = p[0];
+        out[1] = p[1];
+        out[2 - first] = p[2];
+    }
+
+    /// Samples widened so that differences of two are exact: int64 for integer types, double else.
+    using Exact = std::conditional_t<std::is_integral_v<T>, std::int64_t, double>;
+
+    /// Largest minus smallest of the 8 samples of cell (i, j, k).
+    Exact cell_range(std::int64_t i, std::int64_t j, std::int64_t k) const
+    {
+        const T* p = g_.data + g_.offset(i, j, k);
+        const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
+        T lo = p[0], hi = p[0];
+        for (const std::int64_t d : {sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz}) {
+            lo = std::min(lo, p[d]);
+            hi = std::max(hi, p[d]);
+        }
+        return static_cast<Exact>(hi) - static_cast<Exact>(lo);
+    }
+
+    /// MeshSpans::vertex_cell_ranges of the vertex on the edge from sample (i, j, k) along `axis`:
+    /// the largest cell_range() of the (up to four) cells around the edge.
+    float edge_cell_range(std::int64_t i, std::int64_t j, std::int64_t k, int axis) const
+    {
+        const std::int64_t idx[3] = {i, j, k}, n[3] = {nx_, ny_, nz_};
+        const auto b = static_cast<std::size_t>((axis + 1) % 3), c = static_cast<std::size_t>((axis + 2) % 3);
+        Exact largest = 0;
+        if (idx[b] >= 1 && idx[b] + 1 < n[b] && idx[c] >= 1 && idx[c] + 1 < n[c]) {
+            // all four cells: the smallest and largest of the edge's 3 x 3 lines of two samples
+            // along `axis`, then each cell's 2 x 2 of those (selects, no branches)
+            const T* p = g_.data + g_.offset(i, j, k);
+            const std::int64_t sa = g_.strides[static_cast<std::size_t>(axis)], sb = g_.strides[b], sc = g_.strides[c];
+            T lo[3][3], hi[3][3];
+            for (std::int64_t u = 0; u < 3; ++u)
+                for (std::int64_t w = 0; w < 3; ++w) {
+                    const T* q = p + (u - 1) * sb + (w - 1) * sc;
+                    const T x = q[0], y = q[sa];
+                    lo[u][w] = x < y ? x : y;
+                    hi[u][w] = x < y ? y : x;
+                }
+            for (int u = 0; u < 2; ++u)
+                for (int w = 0; w < 2; ++w) {
+                    const T l = std::min(std::min(lo[u][w], lo[u + 1][w]), std::min(lo[u][w + 1], lo[u + 1][w + 1]));
+                    const T h = std::max(std::max(hi[u][w], hi[u + 1][w]), std::max(hi[u][w + 1], hi[u + 1][w + 1]));
+                    const Exact range = static_cast<Exact>(h) - static_cast<Exact>(l);
+                    largest = range > largest ? range : largest;
+                }
+            return static_cast<float>(largest);
+        }
+        for (std::int64_t u = -1; u <= 0; ++u)
+            for (std::int64_t w = -1; w <= 0; ++w) {
+                std::int64_t cell[3] = {i, j, k};
+                cell[b] += u;
+                cell[c] += w;
+                if (cell[b] < 0 || cell[b] + 1 >= n[b] || cell[c] < 0 || cell[c] + 1 >= n[c]) continue;
+                largest = std::max(largest, cell_range(cell[0], cell[1], cell[2]));
+            }
+        return static_cast<float>(largest);
     }
 
     static Mat3 inverse_transpose(const Mat3& m)
@@ -876,7 +968,9 @@ private:
         return scale * static_cast<double>(hi) - scale * static_cast<double>(lo);
     }
 
-    /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them.
+    /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them; the
+    /// extra outputs of MeshSpans only with kExtras.
+    template <bool kExtras>
     void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Scratch& s, const Emit& e) const
     {
         const RowSpan r = span_of(e.c, j, k);
@@ -886,25 +980,26 @@ private:
         for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
             // an axis at a time: on rough surfaces which of a sample's edges cross is unpredictable
             const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
-            emit_axis_vertices<0>(edges.x, w, j, k, ids, e);
-            emit_axis_vertices<1>(edges.y, w, j, k, ids, e);
-            emit_axis_vertices<2>(edges.z, w, j, k, ids, e);
+            emit_axis_vertices<0, kExtras>(edges.x, w, j, k, ids, e);
+            emit_axis_vertices<1, kExtras>(edges.y, w, j, k, ids, e);
+            emit_axis_vertices<2, kExtras>(edges.z, w, j, k, ids, e);
         }
     }
 
     /// The vertices of the crossed edges along `axis` of samples 64 w + b of row (j, k), b a bit of
     /// `crossed`.
-    template <int axis>
+    template <int axis, bool kExtras>
     CMC33_ALWAYS_INLINE void emit_axis_vertices(Word crossed, std::int64_t w, std::int64_t j, std::int64_t k,
                                                 const std::uint32_t* ids, const Emit& e) const
     {
         for (Word bits = crossed; bits != 0; bits &= bits - 1) {
             const std::int64_t i = 64 * w + std::countr_zero(bits);
-            emit_edge_vertex(i, j, k, axis, ids[3 * i + axis], e);
+            emit_edge_vertex<kExtras>(i, j, k, axis, ids[3 * i + axis], e);
         }
     }
 
     /// The vertex `id` on the edge from sample (i, j, k) along `axis`.
+    template <bool kExtras>
     CMC33_ALWAYS_INLINE void emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int axis, std::uint32_t id,
                                               const Emit& e) const
     {
@@ -916,18 +1011,26 @@ private:
         double x[3];
         for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
         const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
-        write_position(x, &out.positions[v * 3]);
-        if (out.normals) write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale));
-        if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
-        if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
-        if (out.vertex_values) {
-            const double va = static_cast<double>(a), vb = static_cast<double>(b);
-            out.vertex_values[v] = static_cast<float>(va + t * (vb - va));
+        const bool zyx = kExtras && out.zyx;
+        write_position(x, &out.positions[v * 3], zyx);
+        if (out.normals) write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx);
+        if constexpr (kExtras) {
+            if (out.vertex_cell_ranges && k == e.c.k0_ && k > 0 && axis != 2) {
+                // an x or y edge of the range's first plane: the cells below it are the previous
+                // range's, which does not write this range's values (emit_row_cells)
+                out.vertex_cell_ranges[v] = std::max(out.vertex_cell_ranges[v], edge_cell_range(i, j, k, axis));
+            }
+            if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
+            if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
+            if (out.vertex_values) {
+                const double va = static_cast<double>(a), vb = static_cast<double>(b);
+                out.vertex_values[v] = static_cast<float>(va + t * (vb - va));
+            }
         }
     }
 
-    /// Normals point from above to below: along minus the world gradient.
-    void write_normal(float* out, std::array<double, 3> g) const
+    /// Normals point from above to below: along minus the world gradient. `zyx` as in write_position.
+    CMC33_ALWAYS_INLINE void write_normal(float* out, std::array<double, 3> g, bool zyx) const
     {
         if (!diagonal_) {
             const Mat3& n = normal_map_;
@@ -948,12 +1051,15 @@ private:
             return;
         }
         const double minus_inverse = -1 / len; // one divide, then multiplies
-        for (std::size_t c = 0; c < 3; ++c) out[c] = static_cast<float>(g[c] * minus_inverse);
+        float n[3];
+        for (std::size_t c = 0; c < 3; ++c) n[c] = static_cast<float>(g[c] * minus_inverse);
+        store(n, out, zyx);
     }
 
     /// The cells of cell row (j, k): interior vertices from id `vertex` on and triangles from id
     /// `tri` on; both are left one past the last written. Cells with a test take the next of
-    /// count's decisions, from `decision` on.
+    /// count's decisions, from `decision` on. The extra outputs of MeshSpans only with kExtras.
+    template <bool kExtras>
     void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& vertex,
                         std::int64_t& tri, std::size_t& decision) const
     {
@@ -977,6 +1083,7 @@ private:
         const std::vector<std::uint8_t>& decisions = e.c.decisions_;
         const std::int64_t row_end = e.off.first_triangle + r.t1;
         const std::uint8_t* const padded_table = padded_codes().data();
+        const bool flip = kExtras ? mirrored_ != out.reverse_winding : mirrored_;
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
@@ -1018,15 +1125,35 @@ private:
                     o[q] = v < 12 ? edge_ids[v][3 * i] : static_cast<std::uint32_t>(first_interior + (v - 12));
                 }
             }
-            if (mirrored_) {
+            if (flip) {
                 for (int q = 0; q < n; q += 3) std::swap(o[q + 1], o[q + 2]);
             }
-            if (out.triangle_cells) {
+            if constexpr (kExtras) {
+                if (out.vertex_cell_ranges) raise_cell_range(i, j, k, code, edge_ids, e);
+            }
+            if (kExtras && out.triangle_cells) {
                 const std::int64_t cell = i + nx_ * (j + ny_ * k);
                 for (int q = 0; q < tl->triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
             tri += tl->triangle_count;
           }
+        }
+    }
+
+    /// MeshSpans::vertex_cell_ranges: raises the values of the vertices on the crossed edges of cell
+    /// (i, j, k) (case code `code`; every one of them is used by the cell's triangles) to the
+    /// cell's range. The next range's vertices (the edges of plane k1) are left to it: it reaches
+    /// the cells below them through edge_cell_range().
+    CMC33_ALWAYS_INLINE void raise_cell_range(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code,
+                                              const std::uint32_t* const* edge_ids, const Emit& e) const
+    {
+        const auto range = static_cast<float>(cell_range(i, j, k));
+        // this range's vertices are [first, first + vertices_) globally, from `values` on
+        const std::int64_t first = e.off.first_vertex;
+        float* values = e.out.vertex_cell_ranges + (first - e.out.first_vertex);
+        for (unsigned crossed = kCrossedEdges[code]; crossed != 0; crossed &= crossed - 1) {
+            const auto v = static_cast<std::uint64_t>(edge_ids[std::countr_zero(crossed)][3 * i] - first);
+            if (v < static_cast<std::uint64_t>(e.c.vertices_)) values[v] = std::max(values[v], range);
         }
     }
 
@@ -1078,17 +1205,18 @@ private:
             detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
             const auto v = static_cast<std::size_t>(first + q - out.first_vertex);
             const double x[3] = {base[0] + p[0], base[1] + p[1], base[2] + p[2]};
-            write_position(x, &out.positions[v * 3]);
+            write_position(x, &out.positions[v * 3], out.zyx);
             double w[8];
             if (out.normals || out.vertex_values) detail::trilinear_weights(p, w);
             if (out.normals) {
                 std::array<double, 3> n{};
                 for (int c = 0; c < 8; ++c)
                     for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
-                write_normal(&out.normals[v * 3], n);
+                write_normal(&out.normals[v * 3], n, out.zyx);
             }
             if (out.vertex_edges) out.vertex_edges[v] = -1 - (i + nx_ * (j + ny_ * k));
             if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
+            if (out.vertex_cell_ranges) out.vertex_cell_ranges[v] = static_cast<float>(cell_range(i, j, k));
             if (out.vertex_values) {
                 double f = 0;
                 for (int c = 0; c < 8; ++c) f += w[c] * static_cast<double>(value[c]);

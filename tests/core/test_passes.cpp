@@ -48,16 +48,21 @@ Volume noise(cmc33::Index3 dims, std::uint64_t seed)
 /// The output of a split run: arrays for the global ids [first_vertex, first_vertex + n).
 struct Output {
     std::int64_t first_vertex = 0, first_triangle = 0;
-    std::vector<float> positions, normals, parameters, values;
+    std::vector<float> positions, normals, parameters, values, ranges;
     std::vector<std::uint32_t> triangles;
     std::vector<std::int64_t> edges, cells;
+};
+
+/// How emit writes (MeshSpans::zyx, reverse_winding).
+struct Layout {
+    bool zyx = false, reverse_winding = false;
 };
 
 /// count / scan / emit over the ranges [b[r], b[r + 1]), each range given only its slice of the
 /// output (element 0 of its arrays is its own first vertex and triangle).
 template <class T>
 Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, const std::vector<std::int64_t>& b,
-                 std::int64_t first_vertex = 0, std::int64_t first_triangle = 0)
+                 std::int64_t first_vertex = 0, std::int64_t first_triangle = 0, Layout layout = {})
 {
     std::vector<RangeCounts> counts;
     for (std::size_t r = 0; r + 1 < b.size(); ++r) counts.push_back(cmc33::count(g, iso, opt, b[r], b[r + 1]));
@@ -68,6 +73,7 @@ Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, co
     for (const RangeCounts& c : counts) nv += c.vertex_count(), nt += c.triangle_count();
     const auto v = static_cast<std::size_t>(nv), t = static_cast<std::size_t>(nt);
     o.positions.assign(3 * v, NAN), o.normals.assign(3 * v, NAN), o.parameters.assign(v, NAN), o.values.assign(v, NAN);
+    o.ranges.assign(v, NAN);
     o.triangles.assign(3 * t, 0xdeadbeef), o.edges.assign(v, -7), o.cells.assign(t, -7);
     for (std::size_t r = 0; r < counts.size(); ++r) {
         const auto dv = static_cast<std::size_t>(offsets[r].first_vertex - first_vertex);
@@ -80,6 +86,9 @@ Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, co
         s.vertex_edges = o.edges.data() + dv;
         s.triangles = o.triangles.data() + 3 * dt;
         s.triangle_cells = o.cells.data() + dt;
+        s.vertex_cell_ranges = o.ranges.data() + dv;
+        s.zyx = layout.zyx;
+        s.reverse_winding = layout.reverse_winding;
         s.first_vertex = offsets[r].first_vertex;
         s.first_triangle = offsets[r].first_triangle;
         cmc33::emit(g, iso, opt, counts[r], offsets[r], s);
@@ -198,11 +207,22 @@ void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64
         ASSERT_TRUE((a >= iso) != (b >= iso)) << "vertex " << i << " on an edge that does not cross";
         EXPECT_NEAR(o.values[i], a + static_cast<double>(t) * (b - a), 1e-3) << i;
     }
-    // every triangle lies in its cell, and an interior vertex's cell is that of its triangles
+    // every triangle lies in its cell, and an interior vertex's cell is that of its triangles;
+    // a vertex's cell range is the largest of its triangles' cells'
+    std::vector<double> largest_range(nv, 0.0);
     for (std::size_t t = 0; t < o.cells.size(); ++t) {
         const std::int64_t c = o.cells[t];
         ASSERT_GE(c, 0);
         const std::int64_t corner[3] = {c % nx, c / nx % ny, c / (nx * ny)};
+        double lo = INFINITY, hi = -INFINITY;
+        for (int q = 0; q < 8; ++q) {
+            const double value = g(corner[0] + (q & 1), corner[1] + (q >> 1 & 1), corner[2] + (q >> 2));
+            lo = std::min(lo, value), hi = std::max(hi, value);
+        }
+        for (int q = 0; q < 3; ++q) {
+            const std::size_t vtx = o.triangles[3 * t + static_cast<std::size_t>(q)];
+            largest_range[vtx] = std::max(largest_range[vtx], hi - lo);
+        }
         for (int q = 0; q < 3; ++q) {
             const std::size_t vtx = o.triangles[3 * t + static_cast<std::size_t>(q)];
             ASSERT_LT(vtx, nv);
@@ -215,6 +235,7 @@ void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64
             }
         }
     }
+    for (std::size_t i = 0; i < nv; ++i) ASSERT_EQ(o.ranges[i], static_cast<float>(largest_range[i])) << "vertex " << i;
 }
 
 TEST(Passes, TheExtrasSayWhereEveryVertexAndTriangleCameFrom)
@@ -224,6 +245,33 @@ TEST(Passes, TheExtrasSayWhereEveryVertexAndTriangleCameFrom)
     check_extras(b.view<std::uint8_t>(), 100.0, {0, 9, 20, 32}, interior); // ties
     check_extras(n.view<double>(), 0.0, {0, 4, 5, 13}, interior);
     EXPECT_GT(interior, 0) << "no interior vertex checked";
+}
+
+TEST(Passes, ZyxAndReversedWindingOnlyPermuteTheOutput)
+{
+    const Volume v = noise({9, 7, 12}, 3);
+    ExtractOptions opt;
+    opt.normals = true;
+    const std::vector<std::int64_t> b = {0, 5, 12};
+    v.visit([&](auto view) {
+        const Output plain = run_split(view, 0.05, opt, b);
+        for (const Layout layout : {Layout{true, false}, Layout{false, true}, Layout{true, true}}) {
+            const Output o = run_split(view, 0.05, opt, b, 0, 0, layout);
+            for (std::size_t i = 0; i < plain.positions.size(); i += 3) {
+                for (std::size_t c = 0; c < 3; ++c) {
+                    const std::size_t to = i + (layout.zyx ? 2 - c : c);
+                    ASSERT_EQ(o.positions[to], plain.positions[i + c]);
+                    ASSERT_EQ(o.normals[to], plain.normals[i + c]);
+                }
+            }
+            for (std::size_t t = 0; t < plain.triangles.size(); t += 3) {
+                ASSERT_EQ(o.triangles[t], plain.triangles[t]);
+                ASSERT_EQ(o.triangles[t + 1], plain.triangles[t + (layout.reverse_winding ? 2 : 1)]);
+                ASSERT_EQ(o.triangles[t + 2], plain.triangles[t + (layout.reverse_winding ? 1 : 2)]);
+            }
+            EXPECT_EQ(o.ranges, plain.ranges);
+        }
+    });
 }
 
 TEST(Passes, ProgressRisesToOneAndCancellingThrows)

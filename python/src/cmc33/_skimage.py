@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any, Optional, Sequence, Tuple
 
 import numpy as np
@@ -18,6 +19,14 @@ _METHODS = {
     "lorensen": "mc",
     "_lorensen": "mc",
 }
+
+
+def _check_level(samples: np.ndarray, level: float, threads: int) -> None:
+    """ValueError, as scikit-image raises it, for a level outside the data range."""
+    low, high = _cmc33.value_range(samples, threads)
+    if level < low or level > high:
+        raise ValueError(f"Surface level must be within volume data range: level {level:g}, "
+                         f"data from {low:g} to {high:g}")
 
 
 def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Sequence[float] = (1., 1., 1.),
@@ -140,22 +149,26 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
         # cell (k, j, i) of the stepped grid is kept where the mask holds at its far corner
         mask_cells = mask[step::step, step::step, step::step]
 
-    low, high = _cmc33.value_range(samples, threads)
     if level is None:
+        low, high = _cmc33.value_range(samples, threads)
         level = 0.5 * (low + high)
     else:
+        # No pass over the data for its range here: a mesh with a triangle has a sample at or
+        # above the level and one below it, so min < level <= max. Only an empty mesh needs the
+        # range, to tell a level outside it (ValueError) from no surface (RuntimeError).
         level = float(level)
-        if level < low or level > high:
-            raise ValueError(f"Surface level must be within volume data range: level {level:g}, "
-                             f"data from {low:g} to {high:g}")
+        if not math.isfinite(level):
+            raise ValueError(f"Surface level must be within volume data range: level {level:g}")
 
     grid = samples[::step, ::step, ::step] if step > 1 else samples
     if min(grid.shape) < 2:
+        _check_level(samples, level, threads)
         raise RuntimeError(f"No surface found at the given iso value: step_size {step} leaves the grid "
                            f"{grid.shape}, with fewer than 2 samples along an axis")
     verts, faces, normals, values = _cmc33.marching_cubes(
         grid, level, tuple(s * step for s in spacing), _METHODS[method], gradient_direction == "descent",
         mask_cells, threads, None)
     if len(faces) == 0:
+        _check_level(samples, level, threads)
         raise RuntimeError(f"No surface found at the given iso value: level {level:g}")
     return verts, faces, normals, values

@@ -107,6 +107,17 @@ struct MeshSpans {
     float* vertex_values = nullptr;
     /// Per triangle: the cell it lies in, i + nx * (j + ny * k) of the cell's lowest corner.
     std::int64_t* triangle_cells = nullptr;
+    /// Per vertex: the largest range of samples (largest minus smallest of a cell's 8) among the
+    /// cells whose triangles use the vertex: for an edge vertex every cell of the grid around its
+    /// edge (each of them is crossed there), for an interior vertex its own cell. This is
+    /// scikit-image's `values` of marching_cubes; it depends on the grid alone, so every range
+    /// writes just its own vertices'.
+    float* vertex_cell_ranges = nullptr;
+    /// Write positions and normals as (z, y, x) instead of (x, y, z): the axis order of a C-ordered
+    /// (numpy) array whose last axis is x. Nothing else changes (the winding stays that of x, y, z).
+    bool zyx = false;
+    /// Wind every triangle the other way round (normals are not changed).
+    bool reverse_winding = false;
     std::int64_t first_vertex = 0;   ///< global id of element 0 of the vertex arrays
     std::int64_t first_triangle = 0; ///< global id of element 0 of the triangle arrays
 };
