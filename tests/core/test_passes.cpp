@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -214,7 +215,7 @@ void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64
         const std::int64_t c = o.cells[t];
         ASSERT_GE(c, 0);
         const std::int64_t corner[3] = {c % nx, c / nx % ny, c / (nx * ny)};
-        double lo = INFINITY, hi = -INFINITY;
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
         for (int q = 0; q < 8; ++q) {
             const double value = g(corner[0] + (q & 1), corner[1] + (q >> 1 & 1), corner[2] + (q >> 2));
             lo = std::min(lo, value), hi = std::max(hi, value);
