@@ -139,6 +139,9 @@ private:
 class IdRows {
 public:
     explicit IdRows(std::int64_t nx) : ids_(4 * 3 * static_cast<std::size_t>(nx)), len_(3 * static_cast<std::size_t>(nx)) {}
+    /// Slot s's ids start at base() + s * row_length(); row (j, k) has slot (j & 1) | (k & 1) << 1.
+    const std::uint32_t* base() const noexcept { return ids_.data(); }
+    std::size_t row_length() const noexcept { return len_; }
     /// Row (j, k); `fresh` when its slot held another row and must be filled.
     std::uint32_t* get(std::int64_t j, std::int64_t k, bool& fresh, std::int64_t*& interior_start)
     {
@@ -385,6 +388,7 @@ public:
             fixed_tiling_[code] = tested ? nullptr : &first.tilings[0];
             fixed_subcase_[code] = first.subcase;
         }
+        build_short_tilings();
     }
 
     /// Gives every range the bound on |sample| of them all (which have read every sample).
@@ -684,6 +688,31 @@ private:
 
     /// Tilings of at most this many triangles are written a fixed 3 * kShortTiling ids at a time.
     static constexpr int kShortTiling = 4;
+
+    /// short_count_ and short_offsets_: for the case codes whose fixed tiling has no interior
+    /// vertex and at most kShortTiling triangles, where each id of their triangles sits in the
+    /// four id rows of IdRows, so that emit_row_cells goes from a cell's code to its ids in two
+    /// loads. (Not for grids so wide that the offsets pass 32 bits.)
+    void build_short_tilings()
+    {
+        short_count_.fill(-1);
+        const std::int64_t length = 3 * nx_; // IdRows::row_length()
+        if (4 * length > std::numeric_limits<std::int32_t>::max()) return;
+        short_offsets_.assign(4 * 256 * 3 * kShortTiling, 0);
+        for (unsigned code = 0; code < 256; ++code) {
+            const detail::Tiling* tl = fixed_tiling_[code];
+            if (tl == nullptr || tl->interior_count != 0 || tl->triangle_count > kShortTiling) continue;
+            short_count_[code] = static_cast<std::int8_t>(tl->triangle_count);
+            const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
+            for (unsigned parity = 0; parity < 4; ++parity)
+                for (int q = 0; q < 3 * tl->triangle_count; ++q) {
+                    // past the tiling the entries stay 0: slot 0's first id, always inside the rows
+                    const std::size_t edge = codes[q];
+                    short_offsets_[(parity * 256 + code) * 3 * kShortTiling + static_cast<std::size_t>(q)] =
+                        static_cast<std::int32_t>((parity ^ kEdgeRow[edge]) * length + kEdgeSlot[edge]);
+                }
+        }
+    }
 
     /// kTriangleCodes followed by 3 * kShortTiling zeros, so that a short tiling's fixed-size copy
     /// stays inside the table (both table sets index it).
@@ -1080,10 +1109,13 @@ private:
         const Word* f11 = flags(j + 1, k + 1, s);
         const RowSpan r = span_of(e.c, j, k);
         const MeshSpans& out = e.out;
-        const std::vector<std::uint8_t>& decisions = e.c.decisions_;
         const std::int64_t row_end = e.off.first_triangle + r.t1;
         const std::uint8_t* const padded_table = padded_codes().data();
         const bool flip = kExtras ? mirrored_ != out.reverse_winding : mirrored_;
+        // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
+        const std::int32_t* const short_offsets =
+            short_offsets_.data() + static_cast<std::size_t>((j & 1) | (k & 1) << 1) * 256 * 3 * kShortTiling;
+        const std::uint32_t* const id_base = s.ids.base();
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
@@ -1094,50 +1126,72 @@ private:
             const int bit = std::countr_zero(bits);
             const std::int64_t i = 64 * w + bit;
             const unsigned code = cell_codes(bit);
-            const detail::Tiling* tl = fixed_tiling_[code];
-            if (tl == nullptr) {
-                tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
-                ++decision;
-            }
-            if (tl == nullptr || vertex + tl->interior_count > e.off.first_vertex + r.v1 ||
-                tri + tl->triangle_count > e.off.first_triangle + r.t1) {
-                throw_mismatch("cells", j, k); // before writing past the row's part of the output
-            }
-            const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
             const auto t0 = static_cast<std::size_t>(tri - out.first_triangle);
             std::uint32_t* o = &out.triangles[t0 * 3];
-            const int n = 3 * tl->triangle_count;
-            if (tl->interior_count == 0) {
-                if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= row_end) {
-                    // always 3 * kShortTiling entries, the ones past the tiling overwritten by the
-                    // row's next cells: no loop whose length the branch predictor has to guess
-                    const std::uint8_t* padded = &padded_table[static_cast<std::size_t>(tl->first_triangle) * 3];
-                    for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = edge_ids[padded[q]][3 * i];
-                } else {
-                    for (int q = 0; q < n; ++q) o[q] = edge_ids[codes[q]][3 * i];
-                }
+            int count = short_count_[code]; // triangles written
+            if (count >= 0 && tri + kShortTiling <= row_end) {
+                // most cells: a fixed short tiling, 3 * kShortTiling ids, the ones past the
+                // tiling overwritten by the row's next cells (no loop whose length the branch
+                // predictor has to guess); row_end bounds the triangles
+                const std::int32_t* offset = short_offsets + static_cast<std::size_t>(code) * 3 * kShortTiling;
+                const std::uint32_t* at = id_base + 3 * i;
+                for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = at[offset[q]];
             } else {
-                const std::int64_t first_interior = vertex;
-                write_interior_vertices(i, j, k, *tl, vertex, e);
-                vertex += tl->interior_count;
-                for (int q = 0; q < n; ++q) {
-                    const int v = codes[q];
-                    o[q] = v < 12 ? edge_ids[v][3 * i] : static_cast<std::uint32_t>(first_interior + (v - 12));
-                }
+                count = emit_cell(i, j, k, code, edge_ids, padded_table, row_end, r, e, o, vertex, decision);
             }
             if (flip) {
-                for (int q = 0; q < n; q += 3) std::swap(o[q + 1], o[q + 2]);
+                for (int q = 0; q < 3 * count; q += 3) std::swap(o[q + 1], o[q + 2]);
             }
             if constexpr (kExtras) {
                 if (out.vertex_cell_ranges) raise_cell_range(i, j, k, code, edge_ids, e);
+                if (out.triangle_cells) {
+                    const std::int64_t cell = i + nx_ * (j + ny_ * k);
+                    for (int q = 0; q < count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
+                }
             }
-            if (kExtras && out.triangle_cells) {
-                const std::int64_t cell = i + nx_ * (j + ny_ * k);
-                for (int q = 0; q < tl->triangle_count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
-            }
-            tri += tl->triangle_count;
+            tri += count;
           }
         }
+    }
+
+    /// The triangles of cell (i, j, k) (case code `code`) from `o` on, and its interior vertices
+    /// from id `vertex` on (then moved past them), unless its tiling is a short fixed one (the
+    /// caller's); tested cells replay count's next decision. Returns the number of triangles.
+    int emit_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, const std::uint32_t* const* edge_ids,
+                  const std::uint8_t* padded_table, std::int64_t row_end, const RowSpan& r, const Emit& e,
+                  std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
+    {
+        const std::vector<std::uint8_t>& decisions = e.c.decisions_;
+        const detail::Tiling* tl = fixed_tiling_[code];
+        if (tl == nullptr) {
+            tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
+            ++decision;
+        }
+        const std::int64_t tri = e.out.first_triangle + static_cast<std::int64_t>(o - e.out.triangles) / 3;
+        if (tl == nullptr || vertex + tl->interior_count > e.off.first_vertex + r.v1 ||
+            tri + tl->triangle_count > e.off.first_triangle + r.t1) {
+            throw_mismatch("cells", j, k); // before writing past the row's part of the output
+        }
+        const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
+        const int n = 3 * tl->triangle_count;
+        if (tl->interior_count == 0) {
+            if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= row_end) {
+                // as for the fixed short tilings in emit_row_cells
+                const std::uint8_t* padded = &padded_table[static_cast<std::size_t>(tl->first_triangle) * 3];
+                for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = edge_ids[padded[q]][3 * i];
+            } else {
+                for (int q = 0; q < n; ++q) o[q] = edge_ids[codes[q]][3 * i];
+            }
+        } else {
+            const std::int64_t first_interior = vertex;
+            write_interior_vertices(i, j, k, *tl, vertex, e);
+            vertex += tl->interior_count;
+            for (int q = 0; q < n; ++q) {
+                const int v = codes[q];
+                o[q] = v < 12 ? edge_ids[v][3 * i] : static_cast<std::uint32_t>(first_interior + (v - 12));
+            }
+        }
+        return tl->triangle_count;
     }
 
     /// MeshSpans::vertex_cell_ranges: raises the values of the vertices on the crossed edges of cell
@@ -1246,6 +1300,10 @@ private:
     /// tests); and its subcase then.
     std::array<const detail::Tiling*, 256> fixed_tiling_{};
     std::array<std::uint8_t, 256> fixed_subcase_{};
+    /// build_short_tilings(): per case code its short tiling's triangle count, or -1; per parity
+    /// of the cell row and code, 3 * kShortTiling offsets into IdRows
+    std::array<std::int8_t, 256> short_count_{};
+    std::vector<std::int32_t> short_offsets_;
 };
 
 namespace {
