@@ -1233,8 +1233,8 @@ private:
                 needed |= 1u << (code & 31u); // a tube vertex over that edge's crossing
             }
         }
-        for (int edge = 0; edge < 12; ++edge) {
-            if (!((needed >> edge) & 1u)) continue;
+        for (unsigned left = needed; left != 0; left &= left - 1) { // set bits: no branch per edge
+            const int edge = std::countr_zero(left);
             const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
             const double t = crossing(value[a], value[b]);
             for (int c = 0; c < 3; ++c)

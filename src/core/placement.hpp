@@ -14,6 +14,7 @@
 //   them (tools/gen_tables/gen_tables.py, tube()), embedded for any crossings.
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 
 #include "cube.hpp"
@@ -53,8 +54,8 @@ inline void interior_position(unsigned code, const double (&crossing)[12][3], do
     }
     double sum[3] = {0, 0, 0};
     int n = 0;
-    for (int e = 0; e < 12; ++e) {
-        if (!((code >> e) & 1u)) continue;
+    for (unsigned edges = code & 0xfffu; edges != 0; edges &= edges - 1) { // in edge order, as before
+        const int e = std::countr_zero(edges);
         for (int c = 0; c < 3; ++c) sum[c] += crossing[e][c];
         ++n;
     }
