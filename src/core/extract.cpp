@@ -1117,8 +1117,10 @@ private:
         const std::uint8_t* const padded_table = padded_codes().data();
         const bool flip = kExtras ? mirrored_ != out.reverse_winding : mirrored_;
         // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
+        // (none on grids too wide for them: short_count_ is then -1 for every code)
         const std::int32_t* const short_offsets =
-            short_offsets_.data() + static_cast<std::size_t>((j & 1) | (k & 1) << 1) * 256 * 3 * kShortTiling;
+            short_offsets_.empty() ? nullptr
+                                   : short_offsets_.data() + static_cast<std::size_t>((j & 1) | (k & 1) << 1) * 256 * 3 * kShortTiling;
         const std::uint32_t* const id_base = s.ids.base();
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
