@@ -7,6 +7,8 @@
 #include <cstring>
 #include <limits>
 
+#include "sample_types.hpp"
+
 #if (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
 #define CMC33_CLASSIFY_AVX2 1
 #include <immintrin.h>
@@ -255,14 +257,7 @@ const char* classify_implementation() { return has_avx2() ? "avx2" : "portable";
     template void classify_row<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*, RowScan&); \
     template void classify_row_portable<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*,   \
                                            RowScan&);
-CMC33_INSTANTIATE(std::int8_t)
-CMC33_INSTANTIATE(std::uint8_t)
-CMC33_INSTANTIATE(std::int16_t)
-CMC33_INSTANTIATE(std::uint16_t)
-CMC33_INSTANTIATE(std::int32_t)
-CMC33_INSTANTIATE(std::uint32_t)
-CMC33_INSTANTIATE(float)
-CMC33_INSTANTIATE(double)
+CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 
 } // namespace cmc33::detail

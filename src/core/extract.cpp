@@ -46,6 +46,7 @@
 #include "placement.hpp"
 #include "portability.hpp"
 #include "refine.hpp"
+#include "sample_types.hpp"
 #include "mc33_tables.hpp"
 #include "thread_pool.hpp"
 
@@ -1150,7 +1151,7 @@ private:
                 const std::uint32_t* at = id_base + 3 * i;
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = at[offset[q]];
             } else {
-                count = emit_cell(i, j, k, code, edge_ids, padded_table, row_end, r, e, o, vertex, decision);
+                count = emit_cell(i, j, k, code, edge_ids, padded_table, row_end, r, e, tri, o, vertex, decision);
             }
             if (flip) {
                 for (int q = 0; q < 3 * count; q += 3) std::swap(o[q + 1], o[q + 2]);
@@ -1175,12 +1176,13 @@ private:
         }
     }
 
-    /// The triangles of cell (i, j, k) (case code `code`) from `o` on, and its interior vertices
-    /// from id `vertex` on (then moved past them), unless its tiling is a short fixed one (the
-    /// caller's); tested cells replay count's next decision. Returns the number of triangles.
+    /// The triangles of cell (i, j, k) (case code `code`) from `o` on (triangle id `tri`), and its
+    /// interior vertices from id `vertex` on (then moved past them), unless its tiling is a short
+    /// fixed one (the caller's); tested cells replay count's next decision. Returns the number of
+    /// triangles.
     int emit_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, const std::uint32_t* const* edge_ids,
                   const std::uint8_t* padded_table, std::int64_t row_end, const RowSpan& r, const Emit& e,
-                  std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
+                  std::int64_t tri, std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
     {
         const std::vector<std::uint8_t>& decisions = e.c.decisions_;
         const detail::Tiling* tl = fixed_tiling_[code];
@@ -1188,7 +1190,6 @@ private:
             tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;
             ++decision;
         }
-        const std::int64_t tri = e.out.first_triangle + static_cast<std::int64_t>(o - e.out.triangles) / 3;
         if (tl == nullptr || vertex + tl->interior_count > e.off.first_vertex + r.v1 ||
             tri + tl->triangle_count > e.off.first_triangle + r.t1) {
             throw_mismatch("cells", j, k); // before writing past the row's part of the output
@@ -1540,14 +1541,7 @@ Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, Ex
     template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
     template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
                           const MeshSpans&);
-CMC33_INSTANTIATE(std::int8_t)
-CMC33_INSTANTIATE(std::uint8_t)
-CMC33_INSTANTIATE(std::int16_t)
-CMC33_INSTANTIATE(std::uint16_t)
-CMC33_INSTANTIATE(std::int32_t)
-CMC33_INSTANTIATE(std::uint32_t)
-CMC33_INSTANTIATE(float)
-CMC33_INSTANTIATE(double)
+CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 
 } // namespace cmc33

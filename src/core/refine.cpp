@@ -42,6 +42,7 @@
 #include "cube.hpp"
 #include "decide.hpp"
 #include "mc33_tables.hpp"
+#include "sample_types.hpp"
 
 namespace cmc33::detail {
 namespace {
@@ -451,14 +452,7 @@ template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, con
 #define CMC33_INSTANTIATE(T)                                                                                     \
     template std::vector<SharedFace> shared_tunnel_faces<T>(const GridView<T>&, double);                         \
     template Mesh extract_refined<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);
-CMC33_INSTANTIATE(std::int8_t)
-CMC33_INSTANTIATE(std::uint8_t)
-CMC33_INSTANTIATE(std::int16_t)
-CMC33_INSTANTIATE(std::uint16_t)
-CMC33_INSTANTIATE(std::int32_t)
-CMC33_INSTANTIATE(std::uint32_t)
-CMC33_INSTANTIATE(float)
-CMC33_INSTANTIATE(double)
+CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 
 } // namespace cmc33::detail
