@@ -135,6 +135,21 @@ def shared_faces(positions, edges, spacing):
     return faces
 
 
+def window_rgb(window):
+    """Renders a VTK render window off screen and returns its pixels as an (h, w, 3) uint8 array,
+    top row first."""
+    import vtk
+    from vtk.util import numpy_support
+    window.Render()
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(window)
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    image = grab.GetOutput()
+    w, h, _ = image.GetDimensions()
+    return numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[::-1, :, :3]
+
+
 def save(fig, name):
     """Writes docs/figures/NAME.svg and .png; returns their paths. No date and fixed ids in the
     SVG, so the same data give the same files."""

@@ -169,15 +169,7 @@ def render(panels, focus, size=520):
                 distance = camera.GetDistance()
                 camera.SetClippingRange(distance - 30, distance + 30)
             window.AddRenderer(r)
-    window.Render()
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    image = grab.GetOutput()
-    w, h, _ = image.GetDimensions()
-    rgb = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[::-1, :, :3]
-    return rgb
+    return common.window_rgb(window)
 
 
 def main():

@@ -128,7 +128,6 @@ def main():
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import vtk
-    from vtk.util import numpy_support
 
     with tempfile.TemporaryDirectory() as scratch:
         field = find_field(scratch)
@@ -172,14 +171,8 @@ def main():
         camera.SetViewAngle(34)
         r.ResetCameraClippingRange()
         window.AddRenderer(r)
-    window.Render()
-    grab = vtk.vtkWindowToImageFilter()
-    grab.SetInput(window)
-    grab.ReadFrontBufferOff()
-    grab.Update()
-    image = grab.GetOutput()
-    w, h, _ = image.GetDimensions()
-    rgb = numpy_support.vtk_to_numpy(image.GetPointData().GetScalars()).reshape(h, w, -1)[::-1, :, :3]
+    rgb = common.window_rgb(window)
+    w = rgb.shape[1]
 
     fig, ax = plt.subplots(figsize=(13, 4.9))
     ax.imshow(rgb)

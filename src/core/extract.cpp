@@ -912,19 +912,6 @@ private:
         return static_cast<float>(largest);
     }
 
-    static Mat3 inverse_transpose(const Mat3& m)
-    {
-        // the cofactor matrix over the determinant: (M^-1)^T = cof(M) / det M
-        const double det = determinant(m);
-        Mat3 r{};
-        for (std::size_t i = 0; i < 3; ++i)
-            for (std::size_t j = 0; j < 3; ++j) {
-                const std::size_t i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-                r[i][j] = (m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]) / det;
-            }
-        return r;
-    }
-
     /// A power of two that keeps every scaled gradient, and its interpolation between two samples,
     /// finite: 1 unless the samples or the map to world gradients are near the double range.
     /// (Scaling by a power of two is exact, so ranges with different bounds give the same normals.)

@@ -289,19 +289,6 @@ double unrefine(const std::vector<double>& coord, double x)
     return coord[p] + (x - c) * (coord[p + 1] - coord[p]);
 }
 
-/// The cofactor matrix over the determinant: (M^-1)^T, which maps index gradients to world ones.
-Mat3 inverse_transpose(const Mat3& m)
-{
-    const double det = determinant(m);
-    Mat3 r{};
-    for (std::size_t i = 0; i < 3; ++i)
-        for (std::size_t j = 0; j < 3; ++j) {
-            const std::size_t i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
-            r[i][j] = (m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]) / det;
-        }
-    return r;
-}
-
 /// Half the index-space gradient of the samples at sample (i, j, k): central differences inside,
 /// one-sided at the border (as extract()), halved so that no difference of doubles overflows.
 template <class T> std::array<double, 3> half_gradient(const GridView<T>& g, const Index3& at)

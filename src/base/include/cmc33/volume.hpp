@@ -62,6 +62,19 @@ inline double determinant(const Mat3& m) noexcept
     return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
            m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
+/// (M^-1)^T, the cofactor matrix over the determinant: it maps index-space gradients to world
+/// ones (normals). M must be invertible.
+inline Mat3 inverse_transpose(const Mat3& m) noexcept
+{
+    const double det = determinant(m);
+    Mat3 r{};
+    for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j) {
+            const std::size_t i1 = (i + 1) % 3, i2 = (i + 2) % 3, j1 = (j + 1) % 3, j2 = (j + 2) % 3;
+            r[i][j] = (m[i1][j1] * m[i2][j2] - m[i1][j2] * m[i2][j1]) / det;
+        }
+    return r;
+}
 /// True when only the diagonal is non-zero (an axis-aligned frame, possibly with flips).
 inline bool is_diagonal(const Mat3& m) noexcept
 {
