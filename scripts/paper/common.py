@@ -135,6 +135,18 @@ def shared_faces(positions, edges, spacing):
     return faces
 
 
+def vtk_image(path):
+    """The NRRD volume at `path` as a vtkImageData (samples copied, spacing kept)."""
+    import vtk
+    from vtk.util import numpy_support
+    v, spacing = read_nrrd(path)
+    image = vtk.vtkImageData()
+    image.SetDimensions(v.shape[2], v.shape[1], v.shape[0])
+    image.SetSpacing(*spacing)
+    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(v).ravel(), deep=1))
+    return image
+
+
 def window_rgb(window):
     """Renders a VTK render window off screen and returns its pixels as an (h, w, 3) uint8 array,
     top row first."""

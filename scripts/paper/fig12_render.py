@@ -51,12 +51,7 @@ def polydata(positions, triangles):
 
 def vtk_marching_cubes(path, iso):
     import vtk
-    from vtk.util import numpy_support
-    v, spacing = common.read_nrrd(path)
-    image = vtk.vtkImageData()
-    image.SetDimensions(v.shape[2], v.shape[1], v.shape[0])
-    image.SetSpacing(*spacing)
-    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(v).ravel(), deep=1))
+    image = common.vtk_image(path)
     mc = vtk.vtkMarchingCubes()
     mc.SetInputData(image)
     mc.SetValue(0, iso)

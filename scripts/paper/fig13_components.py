@@ -18,17 +18,11 @@ METHODS = ["cmc33", "chernyaev", "mc33-lewiner", "mc"]
 def vtk_components(path, isos):
     """Components of vtkMarchingCubes' mesh (points merged, as VTK merges them) per isovalue."""
     try:
-        import numpy as np
         import vtk
-        from vtk.util import numpy_support
     except ImportError:
         print("python3-vtk9 is missing: no VTK curve (scripts/install-deps.sh --paper installs it)")
         return None
-    v, spacing = common.read_nrrd(path)
-    image = vtk.vtkImageData()
-    image.SetDimensions(v.shape[2], v.shape[1], v.shape[0])
-    image.SetSpacing(*spacing)
-    image.GetPointData().SetScalars(numpy_support.numpy_to_vtk(np.ascontiguousarray(v).ravel(), deep=1))
+    image = common.vtk_image(path)
     mc = vtk.vtkMarchingCubes()
     mc.SetInputData(image)
     mc.ComputeNormalsOff()
