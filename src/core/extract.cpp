@@ -31,6 +31,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <type_traits>
@@ -75,16 +76,6 @@ constexpr std::array<std::uint8_t, 12> kEdgeSlot = [] {
         s[static_cast<std::size_t>(q)] = static_cast<std::uint8_t>(3 * kCornerOffset[kEdgeCorners[q][0]][0] + q / 4);
     }
     return s;
-}();
-
-/// For each case code, its crossed edges as a 12-bit mask (edge q crosses when its corners differ).
-constexpr std::array<std::uint16_t, 256> kCrossedEdges = [] {
-    std::array<std::uint16_t, 256> m{};
-    for (unsigned code = 0; code < 256; ++code)
-        for (int q = 0; q < 12; ++q) {
-            if (((code >> kEdgeCorners[q][0]) ^ (code >> kEdgeCorners[q][1])) & 1u) m[code] |= static_cast<std::uint16_t>(1u << q);
-        }
-    return m;
 }();
 
 /// A row's above-flags as 64-bit words (classify.hpp), with one zero word after the last so that
@@ -481,41 +472,16 @@ public:
             throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
         }
         const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
-        if (out.vertex_cell_ranges) {
-            // each cell raises the values of its edges' vertices to its range (emit_row_cells)
-            float* values = out.vertex_cell_ranges + (off.first_vertex - out.first_vertex);
-            std::fill(values, values + c.vertices_, 0.0f);
-        }
-        // the usual output (positions, triangles, maybe normals) takes code without the extras'
-        // tests, which cost 2-4 % where they are not taken
-        const bool extras = out.vertex_edges || out.vertex_parameters || out.vertex_values || out.triangle_cells ||
-                            out.vertex_cell_ranges || out.zyx || out.reverse_winding;
         Scratch s(nx_, ny_);
+        if (out.vertex_cell_ranges) s.ranges.emplace(nx_, ny_);
         std::size_t decision = 0; // the next of count's decisions
-        for (std::int64_t k = k0; k < k1; ++k) {
-            const RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - k0) * ny_)];
-            for (std::int64_t j = 0; j < ny_; ++j) {
-                // an empty trim range: no crossed edge or cell, so nothing to emit (most rows of a
-                // CT volume; cheaper than span_of)
-                if (plane[j].hi <= plane[j].lo) continue;
-                const RowSpan r = span_of(c, j, k);
-                if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
-                std::int64_t interior = 0;
-                const std::uint32_t* ids = row_ids(j, k, s, e, interior);
-                if (r.xy0 != r.xy1 || r.z0 != r.v1) {
-                    extras ? emit_row_vertices<true>(j, k, ids, s, e) : emit_row_vertices<false>(j, k, ids, s, e);
-                }
-                std::int64_t vertex_end = interior, triangle_end = off.first_triangle + r.t0;
-                if (r.t1 != r.t0) {
-                    extras ? emit_row_cells<true>(j, k, s, e, vertex_end, triangle_end, decision)
-                           : emit_row_cells<false>(j, k, s, e, vertex_end, triangle_end, decision);
-                }
-                if (vertex_end != off.first_vertex + r.v1 || triangle_end != off.first_triangle + r.t1) {
-                    throw_mismatch("vertices or triangles", j, k);
-                }
-            }
-            if (ticker && !ticker->tick()) return;
+        bool finished = false;    // not stopped by the ticker
+        switch (outputs_of(out)) {
+        case Outputs::plain: finished = emit_planes<Outputs::plain>(e, s, ticker, decision); break;
+        case Outputs::drop_in: finished = emit_planes<Outputs::drop_in>(e, s, ticker, decision); break;
+        case Outputs::all: finished = emit_planes<Outputs::all>(e, s, ticker, decision); break;
         }
+        if (!finished) return;
         if (decision != c.decisions_.size()) {
             throw Error(Status::internal, "emit met " + std::to_string(decision) + " cells with a face or interior test in planes " +
                                               std::to_string(k0) + " to " + std::to_string(k1) + ", count " +
@@ -536,6 +502,75 @@ private:
                                           "the passes, or a bug in cmc33");
     }
 
+    /// Which of MeshSpans' outputs an instantiation of emit's row functions writes. plain:
+    /// positions, triangles and normals, the usual output, without the extras' tests (they cost
+    /// 2-4 % where not taken); drop_in: those in (z, y, x) with vertex_cell_ranges, scikit-image's
+    /// (cmc33.marching_cubes); all: every extra, each tested at run time.
+    enum class Outputs { plain, drop_in, all };
+    static Outputs outputs_of(const MeshSpans& out)
+    {
+        if (out.vertex_edges || out.vertex_parameters || out.vertex_values || out.triangle_cells) return Outputs::all;
+        if (out.vertex_cell_ranges && out.zyx) return Outputs::drop_in;
+        return out.vertex_cell_ranges || out.zyx || out.reverse_winding ? Outputs::all : Outputs::plain;
+    }
+
+    /// MeshSpans::vertex_cell_ranges without a scatter: cell_range() of the crossed cells of two
+    /// cell planes, k (the one emit is in) and k - 1, and an edge vertex's value the largest of
+    /// its up to four cells'. Each plane has a row of nx + 1 floats per cell row, cell i at i + 1;
+    /// entry 0 (cell -1) and entry nx (cell nx - 1) are 0 and never written. The other entries
+    /// are not initialized: only crossed cells are read, all of them written first (a crossed
+    /// edge's cells are all crossed); a plane's row holds the plane two before until then. Cells
+    /// outside the grid or below the range read the zero row.
+    class CellRangeRows {
+    public:
+        CellRangeRows(std::int64_t nx, std::int64_t ny)
+            : len_(static_cast<std::size_t>(nx) + 1), ny_(ny)
+        {
+            ranges_.resize((2 * static_cast<std::size_t>(ny) + 1) * len_);
+#ifndef NDEBUG
+            // debug builds (the sanitizers' in CI) poison the rest: a cell read before it is
+            // written would win every max, and the tests compare the values with their own
+            std::fill(ranges_.begin(), ranges_.end(), std::numeric_limits<float>::infinity());
+#endif
+            for (std::size_t r = 0; r < 2 * static_cast<std::size_t>(ny); ++r) ranges_[r * len_] = ranges_[r * len_ + len_ - 1] = 0;
+            std::fill(ranges_.end() - static_cast<std::ptrdiff_t>(len_), ranges_.end(), 0.0f);
+        }
+        float* row(std::int64_t j, std::int64_t k) noexcept
+        {
+            return &ranges_[(static_cast<std::size_t>(k & 1) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(j)) * len_];
+        }
+        const float* zero() const noexcept { return &ranges_[2 * static_cast<std::size_t>(ny_) * len_]; }
+
+    private:
+        std::size_t len_;
+        std::int64_t ny_;
+        Buffer<float> ranges_; // not zeroed: see above
+    };
+
+    /// The cell rows around sample row (j, k) in CellRangeRows: below[b] is cell row (j - 1 + b,
+    /// k - 1), here[b] (j - 1 + b, k). `first_plane`: k is the range's first plane and not the
+    /// grid's: the cells below are the previous range's, so its x and y edge vertices take
+    /// edge_cell_range() instead.
+    struct CellsAround {
+        const float* below[2];
+        const float* here[2];
+        bool first_plane;
+        /// The value of the vertex on the edge from sample i along `axis`: the largest range of
+        /// the cells around the edge, (i, j - 1 .. j, k - 1 .. k) for x, (i - 1 .. i, j,
+        /// k - 1 .. k) for y, (i - 1 .. i, j - 1 .. j, k) for z.
+        template <int axis> float value(std::int64_t i) const noexcept
+        {
+            const auto c = static_cast<std::size_t>(i); // cell i - 1 at c, cell i at c + 1
+            if constexpr (axis == 0) {
+                return std::max(std::max(below[0][c + 1], below[1][c + 1]), std::max(here[0][c + 1], here[1][c + 1]));
+            } else if constexpr (axis == 1) {
+                return std::max(std::max(below[1][c], below[1][c + 1]), std::max(here[1][c], here[1][c + 1]));
+            } else {
+                return std::max(std::max(here[0][c], here[0][c + 1]), std::max(here[1][c], here[1][c + 1]));
+            }
+        }
+    };
+
     /// One range's emit: its counts, offsets and output.
     struct Emit {
         const RangeCounts& c;
@@ -553,7 +588,7 @@ private:
         SliceMasks masks;
         IdRows ids;
         detail::RowScan scan;
-        std::vector<float> cell_ranges; ///< 8-bit samples: cell_range() of a cell row (emit_row_cells)
+        std::optional<CellRangeRows> ranges; ///< with MeshSpans::vertex_cell_ranges
     };
 
     /// The range-relative ids of row (j, k) of a range: x/y edge vertices [xy0, xy1), z edge and
@@ -578,6 +613,98 @@ private:
         s.t1 = !last_row ? c.rows_[r + 1].triangle_first : last_plane ? c.triangles_ : c.rows_[r + 1].triangle_first;
         s.lo = row.lo, s.hi = row.hi;
         return s;
+    }
+
+    /// emit()'s planes, row by row, with the outputs `kOut` says (one instantiation per kind of
+    /// output, chosen once per range). Returns false when the ticker stopped it.
+    template <Outputs kOut> bool emit_planes(const Emit& e, Scratch& s, Ticker* ticker, std::size_t& decision) const
+    {
+        const RangeCounts& c = e.c;
+        for (std::int64_t k = c.k0_; k < c.k1_; ++k) {
+            const RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - c.k0_) * ny_)];
+            for (std::int64_t j = 0; j < ny_; ++j) {
+                // an empty trim range: no crossed edge or cell, so nothing to emit (most rows of a
+                // CT volume; cheaper than span_of)
+                if (plane[j].hi <= plane[j].lo) continue;
+                const RowSpan r = span_of(c, j, k);
+                if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
+                std::int64_t interior = 0;
+                const std::uint32_t* ids = row_ids(j, k, s, e, interior);
+                // the cells' ranges before the vertices, which take them from the cells around
+                if (kOut != Outputs::plain && s.ranges && r.t1 != r.t0) write_cell_ranges(j, k, r, s);
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, ids, s, e);
+                std::int64_t vertex_end = interior, triangle_end = e.off.first_triangle + r.t0;
+                if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, s, e, vertex_end, triangle_end, decision);
+                if (vertex_end != e.off.first_vertex + r.v1 || triangle_end != e.off.first_triangle + r.t1) {
+                    throw_mismatch("vertices or triangles", j, k);
+                }
+            }
+            if (ticker && !ticker->tick()) return false;
+        }
+        return true;
+    }
+
+    /// The cell rows around sample row (j, k) (CellsAround) in s.ranges.
+    CellsAround cells_around(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e) const
+    {
+        CellRangeRows& rows = *s.ranges;
+        const auto cell_row = [&](std::int64_t cj, std::int64_t ck) {
+            // cells outside the grid, and the previous range's plane (edge_cell_range() there)
+            const bool exists = cj >= 0 && cj + 1 < ny_ && ck >= e.c.k0_ && ck + 1 < nz_;
+            return exists ? rows.row(cj, ck) : rows.zero();
+        };
+        return {{cell_row(j - 1, k - 1), cell_row(j, k - 1)}, {cell_row(j - 1, k), cell_row(j, k)}, k == e.c.k0_ && k > 0};
+    }
+
+    /// cell_range() of the crossed cells of cell row (j, k) into its CellRangeRows row: where x
+    /// is the array's contiguous axis, 8 cells at a time from the first crossed cell not yet
+    /// done, in a loop the compiler vectorizes (a group may reach into the next word's cells,
+    /// which that word computes again); else, and for the row's last cells, cell by cell.
+    /// (cmc33.marching_cubes, one thread: sines 512^3 334 -> 325 ms, CThead 13.0 -> 11.6 ms
+    /// against cell by cell; groups aligned to 8 cells took 3.5 % longer on bonsai; groups of 4
+    /// lost 10 % on CThead and bonsai, of 16 3 % on sines; for 8-bit samples the whole row at
+    /// once was 1.5 % faster on bonsai, and an AVX2 build of the groups 0.5 % on sines: not worth
+    /// a second path.)
+    void write_cell_ranges(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s) const
+    {
+        // the narrowest type whose difference, rounded to float, is cell_range()'s: float for
+        // float (rounding through double first is innocuous: 53 >= 2 * 24 + 2 bits), int for 8-
+        // and 16-bit samples; these vectorize, Exact's int64 would not
+        using Difference = std::conditional_t<std::is_same_v<T, float>, float,
+                                              std::conditional_t<(sizeof(T) <= 2), int, Exact>>;
+        float* ranges = s.ranges->row(j, k) + 1;
+        const Word* f00 = flags(j, k, s);
+        const Word* f10 = flags(j + 1, k, s);
+        const Word* f01 = flags(j, k + 1, s);
+        const Word* f11 = flags(j + 1, k + 1, s);
+        const T* a = g_.data + g_.offset(0, j, k);
+        const T* b = a + g_.strides[1];
+        const T* c = a + g_.strides[2];
+        const T* d = b + g_.strides[2];
+        for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
+            Word bits = crossed_cells(f00, f10, f01, f11, w, x_valid_[static_cast<std::size_t>(w)]);
+            if (sx_ == 1) {
+                while (bits != 0) {
+                    const int first = std::countr_zero(bits);
+                    const std::int64_t i = 64 * w + first;
+                    if (i + 8 >= nx_) break; // the last cells read past the row: one by one
+                    // cell_range()'s tree spelled out on the four rows: through a shared helper
+                    // the loop stopped vectorizing (CThead 11.3 -> 12.8 ms)
+                    for (std::int64_t q = i; q < i + 8; ++q) {
+                        const T low = std::min(std::min(std::min(a[q], a[q + 1]), std::min(b[q], b[q + 1])),
+                                               std::min(std::min(c[q], c[q + 1]), std::min(d[q], d[q + 1])));
+                        const T high = std::max(std::max(std::max(a[q], a[q + 1]), std::max(b[q], b[q + 1])),
+                                                std::max(std::max(c[q], c[q + 1]), std::max(d[q], d[q + 1])));
+                        ranges[q] = static_cast<float>(static_cast<Difference>(high) - static_cast<Difference>(low));
+                    }
+                    bits &= ~(Word{0xff} << first);
+                }
+            }
+            for (; bits != 0; bits &= bits - 1) {
+                const std::int64_t i = 64 * w + std::countr_zero(bits);
+                ranges[i] = static_cast<float>(cell_range(a + i * sx_));
+            }
+        }
     }
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
@@ -860,15 +987,15 @@ private:
     using Exact = std::conditional_t<std::is_integral_v<T>, std::int64_t, double>;
 
     /// Largest minus smallest of the 8 samples of cell (i, j, k).
-    Exact cell_range(std::int64_t i, std::int64_t j, std::int64_t k) const
+    Exact cell_range(std::int64_t i, std::int64_t j, std::int64_t k) const { return cell_range(g_.data + g_.offset(i, j, k)); }
+    /// ... of the cell whose lowest corner sample is at p: pairs, then a tree, no branch.
+    CMC33_ALWAYS_INLINE Exact cell_range(const T* p) const
     {
-        const T* p = g_.data + g_.offset(i, j, k);
-        const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
-        T lo = p[0], hi = p[0];
-        for (const std::int64_t d : {sx, sy, sx + sy, sz, sx + sz, sy + sz, sx + sy + sz}) {
-            lo = std::min(lo, p[d]);
-            hi = std::max(hi, p[d]);
-        }
+        const std::int64_t sy = g_.strides[1], sz = g_.strides[2];
+        const T a0 = p[0], a1 = p[sx_], a2 = p[sy], a3 = p[sx_ + sy];
+        const T a4 = p[sz], a5 = p[sx_ + sz], a6 = p[sy + sz], a7 = p[sx_ + sy + sz];
+        const T lo = std::min(std::min(std::min(a0, a1), std::min(a2, a3)), std::min(std::min(a4, a5), std::min(a6, a7)));
+        const T hi = std::max(std::max(std::max(a0, a1), std::max(a2, a3)), std::max(std::max(a4, a5), std::max(a6, a7)));
         return static_cast<Exact>(hi) - static_cast<Exact>(lo);
     }
 
@@ -991,39 +1118,41 @@ private:
     }
 
     /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them; the
-    /// extra outputs of MeshSpans only with kExtras.
-    template <bool kExtras>
+    /// outputs of MeshSpans that `kOut` says.
+    template <Outputs kOut>
     void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Scratch& s, const Emit& e) const
     {
         const RowSpan r = span_of(e.c, j, k);
         const Word* f = flags(j, k, s);
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+        const CellsAround cells = s.ranges ? cells_around(j, k, s, e) : CellsAround{};
         for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
             // an axis at a time: on rough surfaces which of a sample's edges cross is unpredictable
             const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
-            emit_axis_vertices<0, kExtras>(edges.x, w, j, k, ids, e);
-            emit_axis_vertices<1, kExtras>(edges.y, w, j, k, ids, e);
-            emit_axis_vertices<2, kExtras>(edges.z, w, j, k, ids, e);
+            emit_axis_vertices<0, kOut>(edges.x, w, j, k, ids, cells, e);
+            emit_axis_vertices<1, kOut>(edges.y, w, j, k, ids, cells, e);
+            emit_axis_vertices<2, kOut>(edges.z, w, j, k, ids, cells, e);
         }
     }
 
     /// The vertices of the crossed edges along `axis` of samples 64 w + b of row (j, k), b a bit of
     /// `crossed`.
-    template <int axis, bool kExtras>
+    template <int axis, Outputs kOut>
     CMC33_ALWAYS_INLINE void emit_axis_vertices(Word crossed, std::int64_t w, std::int64_t j, std::int64_t k,
-                                                const std::uint32_t* ids, const Emit& e) const
+                                                const std::uint32_t* ids, const CellsAround& cells, const Emit& e) const
     {
         for (Word bits = crossed; bits != 0; bits &= bits - 1) {
             const std::int64_t i = 64 * w + std::countr_zero(bits);
-            emit_edge_vertex<kExtras>(i, j, k, axis, ids[3 * i + axis], e);
+            emit_edge_vertex<axis, kOut>(i, j, k, ids[3 * i + axis], cells, e);
         }
     }
 
-    /// The vertex `id` on the edge from sample (i, j, k) along `axis`.
-    template <bool kExtras>
-    CMC33_ALWAYS_INLINE void emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int axis, std::uint32_t id,
-                                              const Emit& e) const
+    /// The vertex `id` on the edge from sample (i, j, k) along `axis`; `cells` (CellsAround) only
+    /// with vertex_cell_ranges.
+    template <int axis, Outputs kOut>
+    CMC33_ALWAYS_INLINE void emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, std::uint32_t id,
+                                              const CellsAround& cells, const Emit& e) const
     {
         const MeshSpans& out = e.out;
         const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
@@ -1033,15 +1162,17 @@ private:
         double x[3];
         for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
         const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
-        const bool zyx = kExtras && out.zyx;
+        const bool zyx = kOut == Outputs::drop_in || (kOut == Outputs::all && out.zyx);
         write_position(x, &out.positions[v * 3], zyx);
         if (out.normals) write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx);
-        if constexpr (kExtras) {
-            if (out.vertex_cell_ranges && k == e.c.k0_ && k > 0 && axis != 2) {
-                // an x or y edge of the range's first plane: the cells below it are the previous
-                // range's, which does not write this range's values (emit_row_cells)
-                out.vertex_cell_ranges[v] = std::max(out.vertex_cell_ranges[v], edge_cell_range(i, j, k, axis));
+        if constexpr (kOut != Outputs::plain) {
+            if (kOut == Outputs::drop_in || out.vertex_cell_ranges) {
+                // x and y edges of the range's first plane: the cells below are the previous range's
+                out.vertex_cell_ranges[v] = axis != 2 && cells.first_plane ? edge_cell_range(i, j, k, axis)
+                                                                          : cells.template value<axis>(i);
             }
+        }
+        if constexpr (kOut == Outputs::all) {
             if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
             if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
             if (out.vertex_values) {
@@ -1080,8 +1211,8 @@ private:
 
     /// The cells of cell row (j, k): interior vertices from id `vertex` on and triangles from id
     /// `tri` on; both are left one past the last written. Cells with a test take the next of
-    /// count's decisions, from `decision` on. The extra outputs of MeshSpans only with kExtras.
-    template <bool kExtras>
+    /// count's decisions, from `decision` on. The outputs of MeshSpans that `kOut` says.
+    template <Outputs kOut>
     void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& vertex,
                         std::int64_t& tri, std::size_t& decision) const
     {
@@ -1104,19 +1235,13 @@ private:
         const MeshSpans& out = e.out;
         const std::int64_t row_end = e.off.first_triangle + r.t1;
         const std::uint8_t* const padded_table = padded_codes().data();
-        const bool flip = kExtras ? mirrored_ != out.reverse_winding : mirrored_;
+        const bool flip = kOut != Outputs::plain ? mirrored_ != out.reverse_winding : mirrored_;
         // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
         // (none on grids too wide for them: short_count_ is then -1 for every code)
         const std::int32_t* const short_offsets =
             short_offsets_.empty() ? nullptr
                                    : short_offsets_.data() + static_cast<std::size_t>((j & 1) | (k & 1) << 1) * 256 * 3 * kShortTiling;
         const std::uint32_t* const id_base = s.ids.base();
-        if constexpr (kExtras && sizeof(T) == 1) {
-            if (out.vertex_cell_ranges) {
-                s.cell_ranges.resize(static_cast<std::size_t>(nx_));
-                cell_range_row(j, k, r.lo, std::min<std::int64_t>(r.hi, nx_ - 1), s.cell_ranges.data());
-            }
-        }
         tri = e.off.first_triangle + r.t0;
         // The case codes come from the same flags as the edge ids of row_ids, so a tiling's edges
         // are crossed edges, whose slots row_ids wrote.
@@ -1143,16 +1268,7 @@ private:
             if (flip) {
                 for (int q = 0; q < 3 * count; q += 3) std::swap(o[q + 1], o[q + 2]);
             }
-            if constexpr (kExtras) {
-                if (out.vertex_cell_ranges) {
-                    float range;
-                    if constexpr (sizeof(T) == 1) {
-                        range = s.cell_ranges[static_cast<std::size_t>(i)];
-                    } else {
-                        range = static_cast<float>(cell_range(i, j, k));
-                    }
-                    raise_cell_range(i, range, code, edge_ids, e);
-                }
+            if constexpr (kOut == Outputs::all) {
                 if (out.triangle_cells) {
                     const std::int64_t cell = i + nx_ * (j + ny_ * k);
                     for (int q = 0; q < count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
@@ -1201,49 +1317,6 @@ private:
             }
         }
         return tl->triangle_count;
-    }
-
-    /// cell_range() of the cells (i, j, k), i in [lo, hi), into ranges[i], for 8-bit samples: a
-    /// loop over the row that the compiler vectorizes 16 cells at a time (on bonsai 1.3 ms of 7
-    /// for the values; for wider samples SSE2 has fewer lanes or no unsigned 16-bit min and max,
-    /// and cell by cell was faster: CThead +1.7 ms, sines 512^3 +19 ms this way).
-    void cell_range_row(std::int64_t j, std::int64_t k, std::int64_t lo, std::int64_t hi, float* ranges) const
-    {
-        const T* a = g_.data + g_.offset(0, j, k);
-        const T* b = a + g_.strides[1];
-        const T* c = a + g_.strides[2];
-        const T* d = b + g_.strides[2];
-        const auto row = [&](const std::int64_t sx) {
-            for (std::int64_t i = lo; i < hi; ++i) {
-                const std::int64_t p = i * sx, q = p + sx;
-                const T low = std::min(std::min(std::min(a[p], b[p]), std::min(c[p], d[p])),
-                                       std::min(std::min(a[q], b[q]), std::min(c[q], d[q])));
-                const T high = std::max(std::max(std::max(a[p], b[p]), std::max(c[p], d[p])),
-                                        std::max(std::max(a[q], b[q]), std::max(c[q], d[q])));
-                ranges[i] = static_cast<float>(static_cast<int>(high) - static_cast<int>(low));
-            }
-        };
-        if (sx_ == 1) {
-            row(1); // the same loop with a constant stride: vectorized
-        } else {
-            row(sx_);
-        }
-    }
-
-    /// MeshSpans::vertex_cell_ranges: raises the values of the vertices on the crossed edges of cell
-    /// (i, j, k) (case code `code`; every one of them is used by the cell's triangles) to the
-    /// cell's range. The next range's vertices (the edges of plane k1) are left to it: it reaches
-    /// the cells below them through edge_cell_range().
-    CMC33_ALWAYS_INLINE void raise_cell_range(std::int64_t i, float range, unsigned code,
-                                              const std::uint32_t* const* edge_ids, const Emit& e) const
-    {
-        // this range's vertices are [first, first + vertices_) globally, from `values` on
-        const std::int64_t first = e.off.first_vertex;
-        float* values = e.out.vertex_cell_ranges + (first - e.out.first_vertex);
-        for (unsigned crossed = kCrossedEdges[code]; crossed != 0; crossed &= crossed - 1) {
-            const auto v = static_cast<std::uint64_t>(edge_ids[std::countr_zero(crossed)][3 * i] - first);
-            if (v < static_cast<std::uint64_t>(e.c.vertices_)) values[v] = std::max(values[v], range);
-        }
     }
 
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by

@@ -54,9 +54,10 @@ struct Output {
     std::vector<std::int64_t> edges, cells;
 };
 
-/// How emit writes (MeshSpans::zyx, reverse_winding).
+/// How emit writes (MeshSpans::zyx, reverse_winding), and whether the extras other than
+/// vertex_cell_ranges are asked for (without them and with zyx: cmc33.marching_cubes's output).
 struct Layout {
-    bool zyx = false, reverse_winding = false;
+    bool zyx = false, reverse_winding = false, other_extras = true;
 };
 
 /// count / scan / emit over the ranges [b[r], b[r + 1]), each range given only its slice of the
@@ -88,6 +89,10 @@ Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, co
         s.triangles = o.triangles.data() + 3 * dt;
         s.triangle_cells = o.cells.data() + dt;
         s.vertex_cell_ranges = o.ranges.data() + dv;
+        if (!layout.other_extras) {
+            s.vertex_parameters = nullptr, s.vertex_values = nullptr, s.vertex_edges = nullptr;
+            s.triangle_cells = nullptr;
+        }
         s.zyx = layout.zyx;
         s.reverse_winding = layout.reverse_winding;
         s.first_vertex = offsets[r].first_vertex;
@@ -204,7 +209,7 @@ void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64
         }
         std::int64_t q[3] = {p[0], p[1], p[2]};
         ++q[axis];
-        const double a = g(p[0], p[1], p[2]), b = g(q[0], q[1], q[2]);
+        const auto a = static_cast<double>(g(p[0], p[1], p[2])), b = static_cast<double>(g(q[0], q[1], q[2]));
         ASSERT_TRUE((a >= iso) != (b >= iso)) << "vertex " << i << " on an edge that does not cross";
         EXPECT_NEAR(o.values[i], a + static_cast<double>(t) * (b - a), 1e-3) << i;
     }
@@ -217,7 +222,7 @@ void check_extras(const GridView<T>& g, double iso, const std::vector<std::int64
         const std::int64_t corner[3] = {c % nx, c / nx % ny, c / (nx * ny)};
         double lo = std::numeric_limits<double>::infinity(), hi = -lo;
         for (int q = 0; q < 8; ++q) {
-            const double value = g(corner[0] + (q & 1), corner[1] + (q >> 1 & 1), corner[2] + (q >> 2));
+            const auto value = static_cast<double>(g(corner[0] + (q & 1), corner[1] + (q >> 1 & 1), corner[2] + (q >> 2)));
             lo = std::min(lo, value), hi = std::max(hi, value);
         }
         for (int q = 0; q < 3; ++q) {
@@ -245,6 +250,58 @@ TEST(Passes, TheExtrasSayWhereEveryVertexAndTriangleCameFrom)
     std::int64_t interior = 0;
     check_extras(b.view<std::uint8_t>(), 100.0, {0, 9, 20, 32}, interior); // ties
     check_extras(n.view<double>(), 0.0, {0, 4, 5, 13}, interior);
+    EXPECT_GT(interior, 0) << "no interior vertex checked";
+}
+
+/// Samples of type T from a seeded noise, quantized to a few levels for integers (ties).
+template <class T> std::vector<T> typed_noise(cmc33::Index3 dims, std::uint64_t seed)
+{
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<T> v(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
+    for (T& x : v) x = static_cast<T>(std::is_integral_v<T> ? std::round(20 * u(rng)) + (std::is_signed_v<T> ? 0 : 40) : u(rng));
+    return v;
+}
+
+TEST(Passes, TheDropInsOutputIsTheExtrasRangesAndPositionsInZyx)
+{
+    // cmc33.marching_cubes's outputs (positions and normals in (z, y, x), vertex_cell_ranges and
+    // nothing else) take their own code in emit: the same numbers as with every extra, which
+    // check_extras checks, for 8-, 16- and 32-bit and float samples, rows long enough for emit's
+    // groups of 8 cells and their ends, and views whose x is not the contiguous axis
+    std::int64_t interior = 0;
+    const auto check = [&](auto tag, double iso) {
+        using T = decltype(tag);
+        const cmc33::Index3 dims = {21, 10, 13};
+        const std::vector<T> samples = typed_noise<T>(dims, 17);
+        const GridView<T> dense = GridView<T>::dense(samples.data(), dims);
+        // the same samples with x and z swapped: x is the slow axis
+        const GridView<T> swapped{samples.data(), {dims[2], dims[1], dims[0]}, {dims[0] * dims[1], dims[0], 1}};
+        ExtractOptions opt;
+        opt.normals = true;
+        for (const GridView<T>& g : {dense, swapped}) {
+            for (const std::vector<std::int64_t>& b : {std::vector<std::int64_t>{0, g.nz()}, {0, 4, 5, g.nz()}}) {
+                check_extras(g, iso, b, interior);
+                const Output all = run_split(g, iso, opt, b);
+                const Output drop_in = run_split(g, iso, opt, b, 0, 0, Layout{true, false, false});
+                ASSERT_EQ(drop_in.positions.size(), all.positions.size());
+                for (std::size_t i = 0; i < all.positions.size(); i += 3) {
+                    for (std::size_t c = 0; c < 3; ++c) {
+                        ASSERT_EQ(drop_in.positions[i + 2 - c], all.positions[i + c]) << i;
+                        ASSERT_EQ(drop_in.normals[i + 2 - c], all.normals[i + c]) << i;
+                    }
+                }
+                EXPECT_EQ(drop_in.ranges, all.ranges);
+                EXPECT_EQ(drop_in.triangles, all.triangles);
+            }
+        }
+    };
+    check(std::uint8_t{}, 40.5);
+    check(std::int16_t{}, 0.0);
+    check(std::uint16_t{}, 40.0);
+    check(std::int32_t{}, -0.5);
+    check(float{}, 0.0);
+    check(double{}, 0.25);
     EXPECT_GT(interior, 0) << "no interior vertex checked";
 }
 
