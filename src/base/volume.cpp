@@ -1,9 +1,12 @@
 #include "cmc33/volume.hpp"
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <new>
 #include <string>
+
+#include "portability.hpp"
 
 namespace cmc33 {
 
@@ -56,12 +59,15 @@ Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin)
 {
     const std::size_t bytes = checked_byte_size(type, dims);
     try {
-        data_.reset(new std::byte[bytes]());
+        data_.reset(new std::byte[bytes]);
     } catch (const std::bad_alloc&) {
         throw Error(Status::too_large, "cannot allocate " + std::to_string(bytes) + " bytes for a " +
                                            std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                                            std::to_string(dims[2]) + " " + std::string(type_name(type)) + " volume");
-    }
+    }    // huge pages before the zeros are written (the readers fill this buffer next; the extractor's
+    // passes read it twice)
+    detail::advise_huge_pages_within(data_.get(), bytes);
+    std::memset(data_.get(), 0, bytes);
 }
 
 Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin, std::unique_ptr<std::byte[]> samples)

@@ -19,6 +19,8 @@
 #include "inflate_portable.hpp"
 #endif
 
+#include "portability.hpp"
+
 #include "cmc33/error.hpp"
 
 namespace cmc33::io::detail {
@@ -407,6 +409,7 @@ private:
                             " bytes for the inflated samples (the header declares " +
                             std::to_string(limit_) + ")");
         }
+        cmc33::detail::advise_huge_pages_within(data_.get(), count);
         capacity_ = count;
     }
 

@@ -3,9 +3,11 @@
 //
 //   Int128 / CMC33_HAS_INT128   128-bit integers (GCC, Clang); without them the decisions take the
 //                               filtered-double / GMP path, which gives the same answers, slower
-//   aligned_allocate / aligned_free / advise_huge_pages
+//   aligned_allocate / aligned_free / advise_huge_pages / advise_huge_pages_within
 //                               2 MiB-aligned blocks for large meshes (posix_memalign + madvise;
-//                               _aligned_malloc on Windows; the advice is a no-op where unknown)
+//                               _aligned_malloc on Windows; the advice is a no-op where unknown),
+//                               and the same advice for the whole 2 MiB blocks inside a volume's
+//                               samples before they are first written
 //   map_readonly / unmap        a read-only file mapping for the mesh readers (mmap); nullptr
 //                               where there is none, and the caller reads the file instead
 //   CMC33_ALWAYS_INLINE         for the extractor's per-row functions, which GCC would otherwise
@@ -16,6 +18,7 @@
 // in cmake/cmc33_warnings.cmake.
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdlib>
 
 #if defined(_WIN32)
@@ -65,6 +68,21 @@ inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::si
 {
 #if defined(MADV_HUGEPAGE)
     (void)madvise(p, bytes, MADV_HUGEPAGE);
+#endif
+}
+
+/// advise_huge_pages on the whole 2 MiB blocks inside [p, p + bytes), for memory from new[] that
+/// has not been written yet: its first writes then fault in 2 MiB pages, not 4 KiB ones (the
+/// 512 MiB of a 512^3 float volume: 256 faults instead of 131,072, and the passes that read it
+/// miss the TLB 512 times less often). Nothing below 2 MiB.
+inline void advise_huge_pages_within([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) noexcept
+{
+#if defined(MADV_HUGEPAGE)
+    constexpr std::size_t kHugePage = std::size_t{2} << 20;
+    const auto begin = reinterpret_cast<std::uintptr_t>(p);
+    const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+    const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+    if (last > first) advise_huge_pages(reinterpret_cast<void*>(first), last - first);
 #endif
 }
 
