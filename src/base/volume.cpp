@@ -64,7 +64,8 @@ Volume::Volume(ScalarType type, Index3 dims, Vec3 spacing, Vec3 origin)
         throw Error(Status::too_large, "cannot allocate " + std::to_string(bytes) + " bytes for a " +
                                            std::to_string(dims[0]) + "x" + std::to_string(dims[1]) + "x" +
                                            std::to_string(dims[2]) + " " + std::string(type_name(type)) + " volume");
-    }    // huge pages before the zeros are written (the readers fill this buffer next; the extractor's
+    }
+    // huge pages before the zeros are written (the readers fill this buffer next; the extractor's
     // passes read it twice)
     detail::advise_huge_pages_within(data_.get(), bytes);
     std::memset(data_.get(), 0, bytes);

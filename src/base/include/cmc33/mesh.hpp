@@ -14,8 +14,9 @@
 namespace cmc33 {
 
 namespace detail {
-/// Memory for Buffer: large blocks (2 MiB and more) are 2 MiB aligned and marked for transparent
-/// huge pages, so that filling a big mesh takes hundreds of times fewer page faults.
+/// Memory for Buffer: large blocks (1 MiB and more) are rounded up to whole 2 MiB pages, 2 MiB
+/// aligned and marked for transparent huge pages, so that filling a big mesh takes hundreds of
+/// times fewer page faults.
 /// @throws Error{too_large} "cannot allocate N bytes for the mesh (out of memory)"
 CMC33_BASE_EXPORT void* allocate_buffer(std::size_t bytes);
 CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
