@@ -23,7 +23,7 @@
 namespace cmc33::detail {
 
 namespace {
-constexpr std::size_t kHugePage = std::size_t{2} << 20;
+constexpr std::size_t kHugePage = kHugePageBytes;
 constexpr std::size_t kLarge = kHugePage / 2;
 
 [[noreturn]] void out_of_memory(std::size_t bytes)

@@ -1126,7 +1126,10 @@ private:
         const Word* f = flags(j, k, s);
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
-        const CellsAround cells = s.ranges ? cells_around(j, k, s, e) : CellsAround{};
+        CellsAround cells{};
+        if constexpr (kOut != Outputs::plain) {
+            if (s.ranges) cells = cells_around(j, k, s, e);
+        }
         for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
             // an axis at a time: on rough surfaces which of a sample's edges cross is unpredictable
             const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);

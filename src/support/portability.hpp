@@ -63,6 +63,10 @@ inline void aligned_free(void* p) noexcept
 #endif
 }
 
+/// The size of an x86-64 transparent huge page: the unit of advise_huge_pages_within and of
+/// Buffer's large blocks (src/base/buffer.cpp).
+inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+
 /// Asks for transparent huge pages on [p, p + bytes) (Linux); advice only, failure is harmless.
 inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) noexcept
 {
@@ -78,10 +82,9 @@ inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::si
 inline void advise_huge_pages_within([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) noexcept
 {
 #if defined(MADV_HUGEPAGE)
-    constexpr std::size_t kHugePage = std::size_t{2} << 20;
     const auto begin = reinterpret_cast<std::uintptr_t>(p);
-    const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
-    const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+    const std::uintptr_t first = (begin + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+    const std::uintptr_t last = (begin + bytes) & ~(kHugePageBytes - 1);
     if (last > first) advise_huge_pages(reinterpret_cast<void*>(first), last - first);
 #endif
 }
