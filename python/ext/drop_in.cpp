@@ -13,6 +13,8 @@
 #include <exception>
 #include <functional>
 #include <limits>
+#include <numeric>
+#include <span>
 #include <string>
 #include <thread>
 #include <utility>
@@ -34,18 +36,21 @@ constexpr std::int64_t kPlanesPerRangeAlone = 64;
 constexpr std::int64_t kMinRanges = 32;
 constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
 
-/// Runs job(r, t) for r in [0, ranges) on n threads t = 0 .. n - 1 (0 the calling one), each
-/// range taken by whichever thread is free. No range starts once control says stop or a job has
-/// thrown; then the error of the lowest range that threw is rethrown, or Error{cancelled}.
-/// Reports the fraction from + share * (ranges done / ranges) to control.
-void run_ranges(int n, int ranges, Control& control, double from, double share,
+/// Runs job(r, t) for every range r of `order` (a permutation of 0 .. ranges - 1) on n threads
+/// t = 0 .. n - 1 (0 the calling one), each taking the next range of `order` when it is free. No
+/// range starts once control says stop or a job has thrown; then the error of the lowest range
+/// that threw is rethrown, or Error{cancelled}. Reports the fraction
+/// from + share * (ranges done / ranges) to control.
+void run_ranges(int n, std::span<const int> order, Control& control, double from, double share,
                 const std::function<void(int range, int thread)>& job)
 {
+    const int ranges = static_cast<int>(order.size());
     std::atomic<int> next{0}, done{0};
     std::atomic<bool> failed{false};
-    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(ranges));
+    std::vector<std::exception_ptr> errors(order.size());
     const auto work = [&](int thread) {
-        for (int r = next.fetch_add(1); r < ranges; r = next.fetch_add(1)) {
+        for (int taken = next.fetch_add(1); taken < ranges; taken = next.fetch_add(1)) {
+            const int r = order[static_cast<std::size_t>(taken)];
             if (failed.load(std::memory_order_relaxed) || control.stopped()) return;
             try {
                 job(r, thread);
@@ -84,8 +89,10 @@ public:
                                                   std::max<std::int64_t>(4 * n, kMinRanges))));
         const auto plane = [&](int r) { return nz * r / ranges; };
 
+        std::vector<int> order(static_cast<std::size_t>(ranges));
+        std::iota(order.begin(), order.end(), 0);
         std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
-        run_ranges(n, ranges, control, 0, 0.5, [&](int r, int) {
+        run_ranges(n, order, control, 0, 0.5, [&](int r, int) {
             counts[static_cast<std::size_t>(r)] = count(g_, iso_, options_, plane(r), plane(r + 1));
         });
         const std::vector<RangeOffsets> offsets = scan(counts);
@@ -106,7 +113,13 @@ public:
         // with a mask, per thread, the cells of its range's triangles, reused from range to range
         // (fresh memory for every range would cost a page fault per 4 KiB of it)
         std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(o_.mask ? n : 0));
-        run_ranges(n, ranges, control, 0.5, 0.5, [&](int r, int thread) {
+        // emit's ranges largest first, as extract() does: the threads end nearly together
+        std::stable_sort(order.begin(), order.end(), [&counts](int a, int b) {
+            const RangeCounts& x = counts[static_cast<std::size_t>(a)];
+            const RangeCounts& y = counts[static_cast<std::size_t>(b)];
+            return x.vertex_count() + x.triangle_count() > y.vertex_count() + y.triangle_count();
+        });
+        run_ranges(n, order, control, 0.5, 0.5, [&](int r, int thread) {
             const auto i = static_cast<std::size_t>(r);
             if (o_.mask) {
                 emit_masked_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);
