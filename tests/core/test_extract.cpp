@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -140,6 +141,33 @@ TEST(Extract, ByteIdenticalForEveryThreadCount)
             }
         }
     }
+}
+
+TEST(Extract, ReusedMeshBlocksHoldNoTraceOfTheirLastMesh)
+{
+    // Buffer keeps freed blocks of 1 to 16 MiB for the next allocation of their size
+    // (src/base/buffer.cpp): a mesh written into a block another mesh left dirty is the same
+    const Volume v = sphere(160, 72.0);
+    const ExtractOptions opt{Method::cmc33, true, 2};
+    const cmc33::Mesh first = cmc33::extract(v, 0.0, opt);
+    ASSERT_GE(first.positions.size() * sizeof(float), std::size_t{1} << 20); // a large block
+    std::vector<const void*> freed;
+    {
+        cmc33::Mesh dirty = cmc33::extract(v, 0.0, opt);
+        std::fill(dirty.positions.begin(), dirty.positions.end(), std::numeric_limits<float>::quiet_NaN());
+        std::fill(dirty.normals.begin(), dirty.normals.end(), -7.0f);
+        std::fill(dirty.triangles.begin(), dirty.triangles.end(), 0xdeadbeefu);
+        freed = {dirty.positions.data(), dirty.normals.data(), dirty.triangles.data()};
+    }
+    const cmc33::Mesh again = cmc33::extract(v, 0.0, opt);
+    // the new mesh's arrays are in the blocks the dirty one freed (in some order)
+    for (const void* p : {static_cast<const void*>(again.positions.data()), static_cast<const void*>(again.normals.data()),
+                          static_cast<const void*>(again.triangles.data())}) {
+        EXPECT_NE(std::find(freed.begin(), freed.end(), p), freed.end());
+    }
+    EXPECT_EQ(first.positions, again.positions);
+    EXPECT_EQ(first.normals, again.normals);
+    EXPECT_EQ(first.triangles, again.triangles);
 }
 
 TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
