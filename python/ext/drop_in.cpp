@@ -113,13 +113,7 @@ public:
         // with a mask, per thread, the cells of its range's triangles, reused from range to range
         // (fresh memory for every range would cost a page fault per 4 KiB of it)
         std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(o_.mask ? n : 0));
-        // emit's ranges largest first, as extract() does: the threads end nearly together
-        std::stable_sort(order.begin(), order.end(), [&counts](int a, int b) {
-            const RangeCounts& x = counts[static_cast<std::size_t>(a)];
-            const RangeCounts& y = counts[static_cast<std::size_t>(b)];
-            return x.vertex_count() + x.triangle_count() > y.vertex_count() + y.triangle_count();
-        });
-        run_ranges(n, order, control, 0.5, 0.5, [&](int r, int thread) {
+        run_ranges(n, emit_order(counts), control, 0.5, 0.5, [&](int r, int thread) {
             const auto i = static_cast<std::size_t>(r);
             if (o_.mask) {
                 emit_masked_range(counts[i], offsets[i], m, cells[static_cast<std::size_t>(thread)], seams[i]);

@@ -31,8 +31,7 @@
 namespace cmc33::detail {
 
 namespace {
-constexpr std::size_t kHugePage = kHugePageBytes;
-constexpr std::size_t kLarge = kHugePage / 2;
+constexpr std::size_t kLarge = kHugePageBytes / 2;
 
 [[noreturn]] void out_of_memory(std::size_t bytes)
 {
@@ -85,7 +84,7 @@ private:
 /// `bytes` rounded up to whole huge pages; 0 when that overflows.
 std::size_t whole_pages(std::size_t bytes) noexcept
 {
-    const std::size_t whole = bytes + (kHugePage - 1 - (bytes - 1) % kHugePage);
+    const std::size_t whole = bytes + (kHugePageBytes - 1 - (bytes - 1) % kHugePageBytes);
     return whole < bytes ? 0 : whole;
 }
 } // namespace
@@ -101,7 +100,7 @@ void* allocate_buffer(std::size_t bytes)
     const std::size_t whole = whole_pages(bytes);
     if (whole == 0) out_of_memory(bytes);
     if (void* kept = BlockCache::instance().take(whole)) return kept;
-    void* p = aligned_allocate(kHugePage, whole);
+    void* p = aligned_allocate(kHugePageBytes, whole);
     if (p == nullptr) out_of_memory(bytes);
     advise_huge_pages(p, whole);
     return p;

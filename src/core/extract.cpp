@@ -1518,6 +1518,18 @@ std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t
     return offsets;
 }
 
+std::vector<int> emit_order(std::span<const RangeCounts> ranges)
+{
+    std::vector<int> order(ranges.size());
+    std::iota(order.begin(), order.end(), 0);
+    const auto size_of = [ranges](int r) {
+        const RangeCounts& c = ranges[static_cast<std::size_t>(r)];
+        return c.vertex_count() + c.triangle_count();
+    };
+    std::stable_sort(order.begin(), order.end(), [&size_of](int a, int b) { return size_of(a) > size_of(b); });
+    return order;
+}
+
 template <class T>
 void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out)
@@ -1585,15 +1597,8 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     out.positions = mesh.positions.data();
     out.triangles = mesh.triangles.data();
     out.normals = options.normals ? mesh.normals.data() : nullptr;
-    // emit's ranges largest first (vertices and triangles, what emit's time follows): the last
-    // ones taken are small, so the threads end nearly together however the surface is spread
-    // (bonsai, 2 threads: the plane order left one thread idle for most of a large range)
-    const auto size_of = [&counts](int r) {
-        const RangeCounts& c = counts[static_cast<std::size_t>(r)];
-        return c.vertex_count() + c.triangle_count();
-    };
-    std::stable_sort(order.begin(), order.end(), [&size_of](int a, int b) { return size_of(a) > size_of(b); });
-    for_each_range(n, order, options.executor, ticker, [&](int r) {
+    // largest first (bonsai, 2 threads: the plane order left one thread idle for most of a large range)
+    for_each_range(n, emit_order(counts), options.executor, ticker, [&](int r) {
         extractor.emit(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], out, &ticker);
     });
     if (ticker.cancelled()) throw_cancelled();

@@ -133,6 +133,11 @@ CMC33_CORE_EXPORT RangeCounts count(const GridView<T>& grid, double iso, const E
 CMC33_CORE_EXPORT std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex = 0,
                                std::int64_t first_triangle = 0);
 
+/// The order in which threads should take ranges for emit: their indices, largest first (by
+/// vertices and triangles, what emit's time follows), ties in index order. The last ranges taken
+/// are then small, and the threads end nearly together however the surface is spread.
+CMC33_CORE_EXPORT std::vector<int> emit_order(std::span<const RangeCounts> ranges);
+
 /// Pass 3: writes the range's vertices (positions, and normals etc. where `out` has arrays for them)
 /// and triangles into `out`. `counts` must come from count() on the same grid, iso and method.
 /// Reads planes k0 - 1 .. min(k1 + 1, nz - 1) (the outer two only for normals' central
