@@ -33,16 +33,21 @@ struct RowScan {
     double largest = 0;      ///< the largest |sample| (of the finite ones)
 };
 
+/// What a classified row's flags say as a whole.
+enum class RowSigns : std::uint8_t { below, above, mixed };
+
 /// bits[0 .. (n + 63) / 64) = the above-flags of row[0], row[stride], ..., row[(n - 1) * stride];
-/// the bits past n are 0. Updates `scan` for floating-point T.
+/// the bits past n are 0. Updates `scan` for floating-point T. Returns whether every sample is
+/// below, every one above, or the row has both (summed up as the words are made: read back
+/// from memory right after the stores, a wide load cannot take them from the store buffer).
 template <class T>
-void classify_row(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold, std::uint64_t* bits,
+RowSigns classify_row(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold, std::uint64_t* bits,
                   RowScan& scan);
 
 /// classify_row one sample at a time, whatever the CPU: the reference the tests hold the vector
 /// code to.
 template <class T>
-void classify_row_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold,
+RowSigns classify_row_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold,
                            std::uint64_t* bits, RowScan& scan);
 
 /// Which implementation classify_row uses on this CPU: "avx2" or "portable".

@@ -370,7 +370,7 @@ template <class T> class RangeExtractor {
 public:
     RangeExtractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
         : g_(g), iso_(iso), threshold_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
-          words_((nx_ + 63) / 64), sample_valid_(valid_words(words_, nx_)), x_valid_(valid_words(words_, nx_ - 1)),
+          words_((nx_ + 63) / 64), x_valid_(valid_words(words_, nx_ - 1)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
           delta_(min_crossing(g, m_)), variants_(detail::tables_of(opt.method))
     {
@@ -722,13 +722,10 @@ private:
         std::uint8_t* known = nullptr;
         Word* f = s.masks.get(j, k, fresh, known);
         if (fresh) {
-            detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
-            Word any = 0, all = ~Word{0};
-            for (std::int64_t w = 0; w < words_; ++w) {
-                any |= f[w];
-                all &= f[w] | ~sample_valid_[static_cast<std::size_t>(w)];
-            }
-            *known = all == ~Word{0} ? SliceMasks::kAbove : any ? SliceMasks::kMixed : SliceMasks::kBelow;
+            const detail::RowSigns signs = detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
+            *known = signs == detail::RowSigns::above ? SliceMasks::kAbove
+                     : signs == detail::RowSigns::below ? SliceMasks::kBelow
+                                                        : SliceMasks::kMixed;
         }
         kind = *known;
         return f;
@@ -1402,7 +1399,6 @@ private:
     Method method_;
     std::int64_t nx_, ny_, nz_, sx_;
     std::int64_t words_;               ///< words of a row's flags
-    std::vector<Word> sample_valid_;   ///< bits of the samples 0..nx-1
     std::vector<Word> x_valid_;        ///< bits of the x edges and cells 0..nx-2
     Mat3 m_;                  ///< index to world: M = D * diag(spacing)
     bool diagonal_, mirrored_; ///< M diagonal; det M < 0 (triangles are reversed)

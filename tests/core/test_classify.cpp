@@ -20,6 +20,7 @@ namespace {
 using cmc33::detail::classify_row;
 using cmc33::detail::classify_row_portable;
 using cmc33::detail::RowScan;
+using cmc33::detail::RowSigns;
 using cmc33::detail::Threshold;
 
 template <class T> std::vector<T> random_row(std::size_t n, std::mt19937_64& rng)
@@ -74,17 +75,24 @@ template <class T> void check_type()
                 const std::size_t words = (n + 63) / 64;
                 std::vector<std::uint64_t> fast(words + 1, 0xdeadbeef), slow(words + 1, 0xdeadbeef);
                 RowScan fast_scan, slow_scan;
-                classify_row(data.data(), static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
-                classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th, slow.data(), slow_scan);
+                const RowSigns fast_signs =
+                    classify_row(data.data(), static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
+                const RowSigns slow_signs =
+                    classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th, slow.data(), slow_scan);
                 double largest = 0;
+                std::size_t above = 0;
                 for (std::size_t i = 0; i < 64 * words; ++i) {
                     const bool expected = i < n && static_cast<double>(data[i * static_cast<std::size_t>(stride)]) >= iso;
+                    above += expected ? 1 : 0;
                     ASSERT_EQ(((fast[i / 64] >> (i % 64)) & 1u) != 0, expected)
                         << "sample " << i << " of " << n << ", stride " << stride << ", iso " << iso;
                     ASSERT_EQ(((slow[i / 64] >> (i % 64)) & 1u) != 0, expected) << "portable, sample " << i;
                     if (i < n) largest = std::max(largest, std::fabs(static_cast<double>(data[i * static_cast<std::size_t>(stride)])));
                 }
                 EXPECT_EQ(fast[words], 0xdeadbeefu) << "wrote past the row's words";
+                const RowSigns signs = above == n ? RowSigns::above : above == 0 ? RowSigns::below : RowSigns::mixed;
+                EXPECT_EQ(fast_signs, signs) << above << " of " << n << " above, stride " << stride << ", iso " << iso;
+                EXPECT_EQ(slow_signs, signs) << "portable: " << above << " of " << n << " above";
                 EXPECT_FALSE(fast_scan.non_finite);
                 if constexpr (std::is_floating_point_v<T>) {
                     EXPECT_EQ(fast_scan.largest, largest);
