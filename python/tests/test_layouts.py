@@ -205,6 +205,9 @@ def test_ctrl_c_stops_a_long_extraction_promptly(api):
 
     timer = threading.Timer(0.3, interrupt)
     result = None
+    # Python's own Ctrl-C handler, whatever this process inherited: a shell starts a background
+    # job (`pytest &`) with SIGINT ignored, and Python then installs no handler of its own
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     start = time.perf_counter()
     timer.start()
     try:
@@ -216,6 +219,7 @@ def test_ctrl_c_stops_a_long_extraction_promptly(api):
         stopped = time.perf_counter()
     finally:
         timer.cancel()
+        signal.signal(signal.SIGINT, previous)
     assert result is None, "the extraction ended before the interrupt reached it"
     assert "at" in sent and sent["at"] - start >= 0.3
     assert stopped - sent["at"] < 0.5, f"KeyboardInterrupt {stopped - sent['at']:.3f} s after SIGINT"
