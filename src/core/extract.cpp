@@ -638,9 +638,9 @@ private:
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
                 // the cells' ranges before the vertices, which take them from the cells around
                 if (kOut != Outputs::plain && s.ranges && r.t1 != r.t0) write_cell_ranges(j, k, r, s);
-                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, ids, s, e);
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, ids, s, e);
                 std::int64_t vertex_end = interior, triangle_end = e.off.first_triangle + r.t0;
-                if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, s, e, vertex_end, triangle_end, decision);
+                if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, r, s, e, vertex_end, triangle_end, decision);
                 if (vertex_end != e.off.first_vertex + r.v1 || triangle_end != e.off.first_triangle + r.t1) {
                     throw_mismatch("vertices or triangles", j, k);
                 }
@@ -1120,12 +1120,12 @@ private:
         return scale * static_cast<double>(hi) - scale * static_cast<double>(lo);
     }
 
-    /// The vertices of the crossed edges owned by row (j, k), at the ids row_ids gave them; the
-    /// outputs of MeshSpans that `kOut` says.
+    /// The vertices of the crossed edges owned by row (j, k) (its span `r`), at the ids row_ids
+    /// gave them; the outputs of MeshSpans that `kOut` says.
     template <Outputs kOut>
-    void emit_row_vertices(std::int64_t j, std::int64_t k, const std::uint32_t* ids, Scratch& s, const Emit& e) const
+    void emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const std::uint32_t* ids, Scratch& s,
+                           const Emit& e) const
     {
-        const RowSpan r = span_of(e.c, j, k);
         const Word* f = flags(j, k, s);
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
         const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
@@ -1215,11 +1215,11 @@ private:
         store(n, out, zyx);
     }
 
-    /// The cells of cell row (j, k): interior vertices from id `vertex` on and triangles from id
+    /// The cells of cell row (j, k) (its span `r`): interior vertices from id `vertex` on and triangles from id
     /// `tri` on; both are left one past the last written. Cells with a test take the next of
     /// count's decisions, from `decision` on. The outputs of MeshSpans that `kOut` says.
     template <Outputs kOut>
-    void emit_row_cells(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e, std::int64_t& vertex,
+    void emit_row_cells(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s, const Emit& e, std::int64_t& vertex,
                         std::int64_t& tri, std::size_t& decision) const
     {
         // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
@@ -1237,7 +1237,6 @@ private:
         const Word* f10 = flags(j + 1, k, s);
         const Word* f01 = flags(j, k + 1, s);
         const Word* f11 = flags(j + 1, k + 1, s);
-        const RowSpan r = span_of(e.c, j, k);
         const MeshSpans& out = e.out;
         const std::int64_t row_end = e.off.first_triangle + r.t1;
         const std::uint8_t* const padded_table = padded_codes().data();
