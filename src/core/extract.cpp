@@ -638,9 +638,16 @@ private:
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
                 // the cells' ranges before the vertices, which take them from the cells around
                 if (kOut != Outputs::plain && s.ranges && r.t1 != r.t0) write_cell_ranges(j, k, r, s);
-                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, ids, s, e);
+                // the flags of rows (j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1), or of (j, k)
+                // where a row is past the grid (then no cell reads it)
+                const Word* f[4];
+                f[0] = flags(j, k, s);
+                f[1] = j + 1 < ny_ ? flags(j + 1, k, s) : f[0];
+                f[2] = k + 1 < nz_ ? flags(j, k + 1, s) : f[0];
+                f[3] = j + 1 < ny_ && k + 1 < nz_ ? flags(j + 1, k + 1, s) : f[0];
+                if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, f, ids, s, e);
                 std::int64_t vertex_end = interior, triangle_end = e.off.first_triangle + r.t0;
-                if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, r, s, e, vertex_end, triangle_end, decision);
+                if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, r, f, s, e, vertex_end, triangle_end, decision);
                 if (vertex_end != e.off.first_vertex + r.v1 || triangle_end != e.off.first_triangle + r.t1) {
                     throw_mismatch("vertices or triangles", j, k);
                 }
@@ -1123,12 +1130,10 @@ private:
     /// The vertices of the crossed edges owned by row (j, k) (its span `r`), at the ids row_ids
     /// gave them; the outputs of MeshSpans that `kOut` says.
     template <Outputs kOut>
-    void emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const std::uint32_t* ids, Scratch& s,
-                           const Emit& e) const
+    void emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4],
+                           const std::uint32_t* ids, Scratch& s, const Emit& e) const
     {
-        const Word* f = flags(j, k, s);
-        const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
-        const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s) : f;
+        const Word *f = rows[0], *fy = rows[1], *fz = rows[2];
         CellsAround cells{};
         if constexpr (kOut != Outputs::plain) {
             if (s.ranges) cells = cells_around(j, k, s, e);
@@ -1219,7 +1224,8 @@ private:
     /// `tri` on; both are left one past the last written. Cells with a test take the next of
     /// count's decisions, from `decision` on. The outputs of MeshSpans that `kOut` says.
     template <Outputs kOut>
-    void emit_row_cells(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s, const Emit& e, std::int64_t& vertex,
+    void emit_row_cells(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4], Scratch& s,
+                        const Emit& e, std::int64_t& vertex,
                         std::int64_t& tri, std::size_t& decision) const
     {
         // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
@@ -1233,10 +1239,7 @@ private:
         const std::uint32_t* edge_ids[12 + detail::kMaxInteriorVertices];
         for (std::size_t q = 0; q < 12; ++q) edge_ids[q] = ids[kEdgeRow[q]] + kEdgeSlot[q];
         for (std::size_t q = 12; q < std::size(edge_ids); ++q) edge_ids[q] = ids[0];
-        const Word* f00 = flags(j, k, s);
-        const Word* f10 = flags(j + 1, k, s);
-        const Word* f01 = flags(j, k + 1, s);
-        const Word* f11 = flags(j + 1, k + 1, s);
+        const Word *f00 = rows[0], *f10 = rows[1], *f01 = rows[2], *f11 = rows[3];
         const MeshSpans& out = e.out;
         const std::int64_t row_end = e.off.first_triangle + r.t1;
         const std::uint8_t* const padded_table = padded_codes().data();
