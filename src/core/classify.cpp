@@ -50,7 +50,10 @@ struct Signs {
         any |= m;
         all &= m | ~valid;
     }
-    RowSigns signs() const { return all == ~std::uint64_t{0} ? RowSigns::above : any != 0 ? RowSigns::mixed : RowSigns::below; }
+    RowSigns signs() const
+    {
+        return all == ~std::uint64_t{0} ? RowSigns::above : any != 0 ? RowSigns::mixed : RowSigns::below;
+    }
 };
 
 /// One sample at a time: the reference the vector code must equal, and the strided path.
@@ -289,9 +292,9 @@ const char* classify_implementation() { return has_avx2() ? "avx2" : "portable";
 
 #define CMC33_INSTANTIATE(T)                                                                                     \
     template struct Threshold<T>;                                                                                \
-    template RowSigns classify_row<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*,        \
+    template RowSigns classify_row<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&, std::uint64_t*, \
                                       RowScan&);                                                                 \
-    template RowSigns classify_row_portable<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&,              \
+    template RowSigns classify_row_portable<T>(const T*, std::int64_t, std::int64_t, const Threshold<T>&,        \
                                                std::uint64_t*, RowScan&);
 CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE

@@ -41,14 +41,14 @@ enum class RowSigns : std::uint8_t { below, above, mixed };
 /// below, every one above, or the row has both (summed up as the words are made: read back
 /// from memory right after the stores, a wide load cannot take them from the store buffer).
 template <class T>
-RowSigns classify_row(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold, std::uint64_t* bits,
-                  RowScan& scan);
+RowSigns classify_row(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold,
+                      std::uint64_t* bits, RowScan& scan);
 
 /// classify_row one sample at a time, whatever the CPU: the reference the tests hold the vector
 /// code to.
 template <class T>
 RowSigns classify_row_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& threshold,
-                           std::uint64_t* bits, RowScan& scan);
+                               std::uint64_t* bits, RowScan& scan);
 
 /// Which implementation classify_row uses on this CPU: "avx2" or "portable".
 const char* classify_implementation();

@@ -729,7 +729,8 @@ private:
         std::uint8_t* known = nullptr;
         Word* f = s.masks.get(j, k, fresh, known);
         if (fresh) {
-            const detail::RowSigns signs = detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
+            const detail::RowSigns signs =
+                detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
             *known = signs == detail::RowSigns::above ? SliceMasks::kAbove
                      : signs == detail::RowSigns::below ? SliceMasks::kBelow
                                                         : SliceMasks::kMixed;
@@ -1127,8 +1128,9 @@ private:
         return scale * static_cast<double>(hi) - scale * static_cast<double>(lo);
     }
 
-    /// The vertices of the crossed edges owned by row (j, k) (its span `r`), at the ids row_ids
-    /// gave them; the outputs of MeshSpans that `kOut` says.
+    /// The vertices of the crossed edges owned by row (j, k) (its span `r`, its rows of flags as
+    /// emit_planes found them), at the ids row_ids gave them; the outputs of MeshSpans that `kOut`
+    /// says.
     template <Outputs kOut>
     void emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4],
                            const std::uint32_t* ids, Scratch& s, const Emit& e) const
@@ -1220,13 +1222,13 @@ private:
         store(n, out, zyx);
     }
 
-    /// The cells of cell row (j, k) (its span `r`): interior vertices from id `vertex` on and triangles from id
-    /// `tri` on; both are left one past the last written. Cells with a test take the next of
-    /// count's decisions, from `decision` on. The outputs of MeshSpans that `kOut` says.
+    /// The cells of cell row (j, k) (its span `r`, its four rows of flags as emit_planes found
+    /// them): interior vertices from id `vertex` on and triangles from id `tri` on; both are left
+    /// one past the last written. Cells with a test take the next of count's decisions, from
+    /// `decision` on. The outputs of MeshSpans that `kOut` says.
     template <Outputs kOut>
     void emit_row_cells(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4], Scratch& s,
-                        const Emit& e, std::int64_t& vertex,
-                        std::int64_t& tri, std::size_t& decision) const
+                        const Emit& e, std::int64_t& vertex, std::int64_t& tri, std::size_t& decision) const
     {
         // the edge ids of the four sample rows around the cell row: (j,k), (j+1,k), (j,k+1), (j+1,k+1)
         std::int64_t unused = 0;

@@ -77,8 +77,8 @@ template <class T> void check_type()
                 RowScan fast_scan, slow_scan;
                 const RowSigns fast_signs =
                     classify_row(data.data(), static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
-                const RowSigns slow_signs =
-                    classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th, slow.data(), slow_scan);
+                const RowSigns slow_signs = classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th,
+                                                                  slow.data(), slow_scan);
                 double largest = 0;
                 std::size_t above = 0;
                 for (std::size_t i = 0; i < 64 * words; ++i) {
