@@ -41,7 +41,8 @@ template <class T> Threshold<T>::Threshold(double iso)
 
 namespace {
 
-/// RowSigns of a row from its words, summed as they are made.
+/// RowSigns of a row from its words, summed as they are made (a value, kept in registers: the
+/// stores to the words cannot alias it).
 struct Signs {
     std::uint64_t any = 0, all = ~std::uint64_t{0};
     /// Word `m` whose samples are the bits of `valid`.
@@ -58,12 +59,11 @@ struct Signs {
 
 /// One sample at a time: the reference the vector code must equal, and the strided path.
 template <class T>
-void classify_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& th, std::uint64_t* bits,
-                       RowScan& scan, Signs& signs)
+Signs classify_portable(const T* row, std::int64_t n, std::int64_t stride, const Threshold<T>& th, std::uint64_t* bits,
+                        RowScan& scan, Signs signs = {})
 {
     const std::int64_t words = (n + 63) / 64;
     const T t = th.value;
-    Signs acc = signs; // a local: the stores to bits cannot alias it
     for (std::int64_t w = 0; w < words; ++w) {
         const std::int64_t i0 = 64 * w, i1 = std::min<std::int64_t>(n, i0 + 64);
         std::uint64_t m = 0;
@@ -83,9 +83,9 @@ void classify_portable(const T* row, std::int64_t n, std::int64_t stride, const 
             for (std::int64_t i = i0; i < i1; ++i) m |= static_cast<std::uint64_t>(row[i * stride] >= t) << (i - i0);
         }
         bits[w] = m;
-        acc.add(m, i1 - i0 == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << (i1 - i0)) - 1);
+        signs.add(m, i1 - i0 == 64 ? ~std::uint64_t{0} : (std::uint64_t{1} << (i1 - i0)) - 1);
     }
-    signs = acc;
+    return signs;
 }
 
 #if CMC33_CLASSIFY_AVX2
@@ -144,27 +144,24 @@ template <class T> CMC33_AVX2 inline std::uint64_t above64_int(const T* p, __m25
 }
 
 template <class T>
-CMC33_AVX2 void classify_avx2_int(const T* row, std::int64_t n, const Threshold<T>& th, std::uint64_t* bits,
-                                  Signs& signs)
+CMC33_AVX2 Signs classify_avx2_int(const T* row, std::int64_t n, const Threshold<T>& th, std::uint64_t* bits)
 {
     const __m256i b = bias<T>();
     const __m256i t = _mm256_xor_si256(broadcast<T>(th.value), b);
     const std::int64_t full = n / 64;
-    Signs acc; // a local: the stores to bits cannot alias it
+    Signs signs;
     for (std::int64_t w = 0; w < full; ++w) {
         const std::uint64_t m = above64_int<T>(row + 64 * w, t, b);
         bits[w] = m;
-        acc.add(m);
+        signs.add(m);
     }
-    signs = acc;
-    if (n % 64 != 0) {
-        RowScan unused;
-        classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, unused, signs);
-    }
+    if (n % 64 == 0) return signs;
+    RowScan unused;
+    return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, unused, signs);
 }
 
-CMC33_AVX2 void classify_avx2_float(const float* row, std::int64_t n, const Threshold<float>& th, std::uint64_t* bits,
-                                    RowScan& scan, Signs& signs)
+CMC33_AVX2 Signs classify_avx2_float(const float* row, std::int64_t n, const Threshold<float>& th, std::uint64_t* bits,
+                                     RowScan& scan)
 {
     const __m256 t = _mm256_set1_ps(th.value);
     const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
@@ -177,7 +174,7 @@ CMC33_AVX2 void classify_avx2_float(const float* row, std::int64_t n, const Thre
     __m256 largest[2] = {_mm256_setzero_ps(), _mm256_setzero_ps()};
     __m256 bad = _mm256_setzero_ps();
     const std::int64_t full = n / 64;
-    Signs acc; // a local: the stores to bits cannot alias it
+    Signs signs;
     for (std::int64_t w = 0; w < full; ++w) {
         std::uint64_t m = 0;
         for (int q = 0; q < 8; ++q) {
@@ -190,18 +187,18 @@ CMC33_AVX2 void classify_avx2_float(const float* row, std::int64_t n, const Thre
             largest[q & 1] = _mm256_max_ps(largest[q & 1], _mm256_andnot_ps(not_finite, a));
         }
         bits[w] = m;
-        acc.add(m);
+        signs.add(m);
     }
-    signs = acc;
     alignas(32) float lanes[8];
     _mm256_store_ps(lanes, _mm256_max_ps(largest[0], largest[1]));
     for (float x : lanes) scan.largest = std::max(scan.largest, static_cast<double>(x));
     scan.non_finite |= _mm256_movemask_ps(bad) != 0;
-    if (n % 64 != 0) classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
+    if (n % 64 == 0) return signs;
+    return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
 }
 
-CMC33_AVX2 void classify_avx2_double(const double* row, std::int64_t n, const Threshold<double>& th, std::uint64_t* bits,
-                                     RowScan& scan, Signs& signs)
+CMC33_AVX2 Signs classify_avx2_double(const double* row, std::int64_t n, const Threshold<double>& th,
+                                      std::uint64_t* bits, RowScan& scan)
 {
     const __m256d t = _mm256_set1_pd(th.value);
     const __m256d abs_mask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff));
@@ -209,7 +206,7 @@ CMC33_AVX2 void classify_avx2_double(const double* row, std::int64_t n, const Th
     __m256d largest[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()}; // as for float
     __m256d bad = _mm256_setzero_pd();
     const std::int64_t full = n / 64;
-    Signs acc; // a local: the stores to bits cannot alias it
+    Signs signs;
     for (std::int64_t w = 0; w < full; ++w) {
         std::uint64_t m = 0;
         for (int q = 0; q < 16; ++q) {
@@ -222,14 +219,14 @@ CMC33_AVX2 void classify_avx2_double(const double* row, std::int64_t n, const Th
             largest[q & 1] = _mm256_max_pd(largest[q & 1], _mm256_andnot_pd(not_finite, a));
         }
         bits[w] = m;
-        acc.add(m);
+        signs.add(m);
     }
-    signs = acc;
     alignas(32) double lanes[4];
     _mm256_store_pd(lanes, _mm256_max_pd(largest[0], largest[1]));
     for (double x : lanes) scan.largest = std::max(scan.largest, x);
     scan.non_finite |= _mm256_movemask_pd(bad) != 0;
-    if (n % 64 != 0) classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
+    if (n % 64 == 0) return signs;
+    return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
 }
 
 #undef CMC33_AVX2
@@ -261,21 +258,18 @@ RowSigns classify_row(const T* row, std::int64_t n, std::int64_t stride, const T
         if (n % 64 != 0) bits[words - 1] &= (std::uint64_t{1} << (n % 64)) - 1;
         return th.mode == Mode::all ? RowSigns::above : RowSigns::below;
     }
-    Signs signs;
 #if CMC33_CLASSIFY_AVX2
     if (stride == 1 && has_avx2()) {
         if constexpr (std::is_same_v<T, float>) {
-            classify_avx2_float(row, n, th, bits, scan, signs);
+            return classify_avx2_float(row, n, th, bits, scan).signs();
         } else if constexpr (std::is_same_v<T, double>) {
-            classify_avx2_double(row, n, th, bits, scan, signs);
+            return classify_avx2_double(row, n, th, bits, scan).signs();
         } else {
-            classify_avx2_int(row, n, th, bits, signs);
+            return classify_avx2_int(row, n, th, bits).signs();
         }
-        return signs.signs();
     }
 #endif
-    classify_portable(row, n, stride, th, bits, scan, signs);
-    return signs.signs();
+    return classify_portable(row, n, stride, th, bits, scan).signs();
 }
 
 template <class T>
@@ -283,9 +277,7 @@ RowSigns classify_row_portable(const T* row, std::int64_t n, std::int64_t stride
                                std::uint64_t* bits, RowScan& scan)
 {
     if (th.mode != Threshold<T>::Mode::compare) return classify_row(row, n, stride, th, bits, scan);
-    Signs signs;
-    classify_portable(row, n, stride, th, bits, scan, signs);
-    return signs.signs();
+    return classify_portable(row, n, stride, th, bits, scan).signs();
 }
 
 const char* classify_implementation() { return has_avx2() ? "avx2" : "portable"; }

@@ -99,31 +99,30 @@ CMC33_ALWAYS_INLINE Word next_sample(const Word* m, std::int64_t w) { return m[w
 
 /// The above-flags of sample rows, classified row by row on demand, for three consecutive slices
 /// at once (slice k lives in buffer k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at
-/// most. Each row is classified once per thread, with its kind: kBelow or kAbove when every sample
-/// of it is, else kMixed.
+/// most. Each row is classified once per thread, with its signs (detail::RowSigns).
 class SliceMasks {
 public:
     SliceMasks(std::int64_t nx, std::int64_t ny)
         : words_((nx + 63) / 64), stride_(words_ + 1), ny_(ny), bits_(static_cast<std::size_t>(3 * ny * stride_), 0),
-          slice_of_(static_cast<std::size_t>(3 * ny), -1), kind_(static_cast<std::size_t>(3 * ny), 0)
+          slice_of_(static_cast<std::size_t>(3 * ny), -1),
+          signs_(static_cast<std::size_t>(3 * ny), detail::RowSigns::below)
     {
     }
-    /// The words of row (j, k); `fresh` when they must be computed (then also set `kind`).
-    CMC33_ALWAYS_INLINE Word* get(std::int64_t j, std::int64_t k, bool& fresh, std::uint8_t*& kind)
+    /// The words of row (j, k); `fresh` when they must be computed (then also set `signs`).
+    CMC33_ALWAYS_INLINE Word* get(std::int64_t j, std::int64_t k, bool& fresh, detail::RowSigns*& signs)
     {
         const auto row = static_cast<std::size_t>((k % 3) * ny_ + j);
         fresh = slice_of_[row] != k;
         slice_of_[row] = k;
-        kind = &kind_[row];
+        signs = &signs_[row];
         return &bits_[row * static_cast<std::size_t>(stride_)];
     }
-    static constexpr std::uint8_t kBelow = 0, kAbove = 1, kMixed = 2;
 
 private:
     std::int64_t words_, stride_, ny_;
     std::vector<Word> bits_;
     std::vector<std::int64_t> slice_of_;
-    std::vector<std::uint8_t> kind_;
+    std::vector<detail::RowSigns> signs_;
 };
 
 /// Vertex ids of the edges owned by four sample rows, one slot per parity of (j, k): a cell row
@@ -638,13 +637,9 @@ private:
                 const std::uint32_t* ids = row_ids(j, k, s, e, interior);
                 // the cells' ranges before the vertices, which take them from the cells around
                 if (kOut != Outputs::plain && s.ranges && r.t1 != r.t0) write_cell_ranges(j, k, r, s);
-                // the flags of rows (j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1), or of (j, k)
-                // where a row is past the grid (then no cell reads it)
                 const Word* f[4];
-                f[0] = flags(j, k, s);
-                f[1] = j + 1 < ny_ ? flags(j + 1, k, s) : f[0];
-                f[2] = k + 1 < nz_ ? flags(j, k + 1, s) : f[0];
-                f[3] = j + 1 < ny_ && k + 1 < nz_ ? flags(j + 1, k + 1, s) : f[0];
+                detail::RowSigns unused[4];
+                flags_around(j, k, s, f, unused);
                 if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, f, ids, s, e);
                 std::int64_t vertex_end = interior, triangle_end = e.off.first_triangle + r.t0;
                 if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, r, f, s, e, vertex_end, triangle_end, decision);
@@ -722,26 +717,33 @@ private:
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
 
-    /// Above-flags of the samples of row (j, k), and the row's kind (SliceMasks).
-    CMC33_ALWAYS_INLINE const Word* flags(std::int64_t j, std::int64_t k, Scratch& s, std::uint8_t& kind) const
+    /// Above-flags of the samples of row (j, k), and the row's signs.
+    CMC33_ALWAYS_INLINE const Word* flags(std::int64_t j, std::int64_t k, Scratch& s, detail::RowSigns& signs) const
     {
         bool fresh = false;
-        std::uint8_t* known = nullptr;
+        detail::RowSigns* known = nullptr;
         Word* f = s.masks.get(j, k, fresh, known);
-        if (fresh) {
-            const detail::RowSigns signs =
-                detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
-            *known = signs == detail::RowSigns::above ? SliceMasks::kAbove
-                     : signs == detail::RowSigns::below ? SliceMasks::kBelow
-                                                        : SliceMasks::kMixed;
-        }
-        kind = *known;
+        if (fresh) *known = detail::classify_row(g_.data + g_.offset(0, j, k), nx_, sx_, threshold_, f, s.scan);
+        signs = *known;
         return f;
     }
     const Word* flags(std::int64_t j, std::int64_t k, Scratch& s) const
     {
-        std::uint8_t unused = 0;
+        detail::RowSigns unused{};
         return flags(j, k, s, unused);
+    }
+
+    /// The flags and signs of the sample rows around cell row (j, k): (j, k), (j + 1, k),
+    /// (j, k + 1), (j + 1, k + 1); a row past the grid gets (j, k)'s (no cell reads it then).
+    CMC33_ALWAYS_INLINE void flags_around(std::int64_t j, std::int64_t k, Scratch& s, const Word* (&f)[4],
+                                          detail::RowSigns (&signs)[4]) const
+    {
+        f[0] = flags(j, k, s, signs[0]);
+        f[1] = f[2] = f[3] = f[0];
+        signs[1] = signs[2] = signs[3] = signs[0];
+        if (j + 1 < ny_) f[1] = flags(j + 1, k, s, signs[1]);
+        if (k + 1 < nz_) f[2] = flags(j, k + 1, s, signs[2]);
+        if (j + 1 < ny_ && k + 1 < nz_) f[3] = flags(j + 1, k + 1, s, signs[3]);
     }
 
     /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
@@ -892,18 +894,17 @@ private:
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
-        std::uint8_t n0 = 0, n1 = 0, n2 = 0, n3 = 0;
-        const Word* f = flags(j, k, s, n0);
-        n1 = n2 = n3 = n0;
+        const Word* rows[4];
+        detail::RowSigns signs[4];
+        flags_around(j, k, s, rows, signs);
+        const Word *f = rows[0], *fy = rows[1], *fz = rows[2], *fyz = rows[3];
         const bool cells = j + 1 < ny_ && k + 1 < nz_;
-        const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s, n1) : f;
-        const Word* fz = k + 1 < nz_ ? flags(j, k + 1, s, n2) : f;
-        const Word* fyz = cells ? flags(j + 1, k + 1, s, n3) : f;
         if (s.scan.non_finite) {
             // before any cell of these rows is decided (a NaN has no sign): name the first one
             scan_samples(g_, c.k0_, std::min(c.k1_, nz_ - 1));
         }
-        if (n0 != SliceMasks::kMixed && n1 == n0 && n2 == n0 && n3 == n0) return; // counts stay 0
+        const detail::RowSigns first = signs[0]; // all four rows all above or all below: the counts stay 0
+        if (first != detail::RowSigns::mixed && signs[1] == first && signs[2] == first && signs[3] == first) return;
         RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
         std::uint32_t xy = 0, z = 0;
         std::int64_t interior = 0, triangles = 0;
