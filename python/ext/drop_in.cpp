@@ -34,9 +34,6 @@ namespace {
 constexpr std::int64_t kPlanesPerRange = 16;
 constexpr std::int64_t kPlanesPerRangeAlone = 64;
 constexpr std::int64_t kMinRanges = 32;
-// Arrays whose x axis is not contiguous (Fortran order: x has the largest stride) are read, range
-// by range, into a C-ordered window of at most this many bytes per thread (at least 4 planes).
-constexpr std::int64_t kWindowBytes = std::int64_t{4} << 20;
 constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
 
 /// Runs job(r, t) for every range r of `order` (a permutation of 0 .. ranges - 1) on n threads
@@ -89,16 +86,15 @@ public:
         const int n = static_cast<int>(std::clamp<std::int64_t>(resolve_threads(o_.threads), 1, nz));
         std::int64_t ranges = std::min(nz, std::clamp<std::int64_t>(nz / (n == 1 ? kPlanesPerRangeAlone : kPlanesPerRange), n,
                                                                   std::max<std::int64_t>(4 * n, kMinRanges)));
-        // a window holds a range's planes and 3 more (passes.hpp: count reads k0 - 1 .. k1 + 1, so does emit)
-        const std::int64_t plane_bytes = g_.nx() * g_.ny() * static_cast<std::int64_t>(sizeof(T));
-        const bool windowed = std::llabs(g_.strides[0]) != 1 && g_.nx() > 1 && nz > 1;
-        if (windowed) ranges = std::max(ranges, (nz + window_planes(plane_bytes) - 4) / (window_planes(plane_bytes) - 3));
+        // where x is not the contiguous axis (Fortran order), each range is read through a
+        // window() of at most 4 MiB (passes.hpp), one buffer per thread
+        const std::int64_t window_planes = window_range_planes(g_);
+        if (window_planes > 0) ranges = std::max(ranges, (nz + window_planes - 1) / window_planes);
         const auto plane = [&](std::int64_t r) { return nz * r / ranges; };
-        std::vector<Buffer<T>> windows(static_cast<std::size_t>(windowed ? n : 0));
-        // the grid a range's passes read: g_ itself, or its planes copied into the thread's window
+        std::vector<Buffer<T>> windows(static_cast<std::size_t>(window_planes > 0 ? n : 0));
         const auto grid_of = [&](std::int64_t r, int thread) {
-            if (!windowed) return g_;
-            return window(plane(r), plane(r + 1), windows[static_cast<std::size_t>(thread)]);
+            if (window_planes == 0) return g_;
+            return window(g_, plane(r), plane(r + 1), windows[static_cast<std::size_t>(thread)]);
         };
 
         std::vector<int> order(static_cast<std::size_t>(ranges));
@@ -141,53 +137,6 @@ public:
     }
 
 private:
-    /// Planes in a window: kWindowBytes of them, at least 4 (a range of one plane).
-    static std::int64_t window_planes(std::int64_t plane_bytes)
-    {
-        return std::max<std::int64_t>(kWindowBytes / std::max<std::int64_t>(plane_bytes, 1), 4);
-    }
-
-    /// A view of g_ that reads planes k0 - 1 .. k1 + 1 (those of the grid) from `buffer`, where
-    /// they are copied with x contiguous: every index, hence every number the passes compute, is
-    /// the same as through g_. The copy reads runs along g_'s smallest stride; the planes are a
-    /// cache line more than nx * ny samples apart, so that a run's writes, one per plane, do not
-    /// all fall into one cache set (256^2 uint8 Fortran order: 0.50 s -> 0.04 s for bonsai).
-    GridView<T> window(std::int64_t k0, std::int64_t k1, Buffer<T>& buffer) const
-    {
-        const std::int64_t nx = g_.nx(), ny = g_.ny();
-        const std::int64_t lo = std::max<std::int64_t>(k0 - 1, 0), hi = std::min(k1 + 2, g_.nz());
-        const std::int64_t plane = nx * ny + std::max<std::int64_t>(64 / static_cast<std::int64_t>(sizeof(T)), 1);
-        buffer.resize(static_cast<std::size_t>((hi - lo) * plane));
-        T* to = buffer.data();
-        const std::int64_t sx = g_.strides[0], sy = g_.strides[1], sz = g_.strides[2];
-        if (std::llabs(sz) <= std::llabs(sy)) {
-            // z innermost (Fortran order): each (i, j) a run along z, 8 rows j at a time, whose
-            // lines in every plane stay in cache while i runs
-            for (std::int64_t j0 = 0; j0 < ny; j0 += 8)
-                for (std::int64_t i = 0; i < nx; ++i)
-                    for (std::int64_t j = j0; j < std::min(j0 + 8, ny); ++j) {
-                        const T* from = g_.data + i * sx + j * sy + lo * sz;
-                        T* out = to + j * nx + i;
-                        for (std::int64_t k = 0; k < hi - lo; ++k) out[k * plane] = from[k * sz];
-                    }
-        } else {
-            // y innermost: each (i, k) a run along y
-            for (std::int64_t k = lo; k < hi; ++k)
-                for (std::int64_t i = 0; i < nx; ++i) {
-                    const T* from = g_.data + i * sx + k * sz;
-                    T* out = to + (k - lo) * plane + i;
-                    for (std::int64_t j = 0; j < ny; ++j) out[j * nx] = from[j * sy];
-                }
-        }
-        // the view's data pointer stands for sample (0, 0, 0), before the buffer: only planes lo
-        // .. hi - 1 are read through it
-        const auto skip = static_cast<std::uintptr_t>(lo * plane) * sizeof(T);
-        GridView<T> view = g_;
-        view.data = reinterpret_cast<const T*>(reinterpret_cast<std::uintptr_t>(to) - skip);
-        view.strides = {1, nx, plane};
-        return view;
-    }
-
     /// A value for a vertex of the next range, set once every range is done.
     struct SeamValue {
         std::uint32_t vertex;

@@ -1565,8 +1565,20 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     const int n = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, nz));
     // More ranges than threads, taken in turn by whichever thread is free: a surface is seldom
     // spread evenly over the planes. Ranges of at least 8 planes keep the planes read twice (at
-    // the ranges' ends) few; the mesh is the same for every split.
-    const int ranges = n == 1 ? 1 : static_cast<int>(std::clamp<std::int64_t>(nz / 8, n, 8 * std::int64_t{n}));
+    // the ranges' ends) few; the mesh is the same for every split. Where x is not the contiguous
+    // axis, each range is read through a window() (passes.hpp) of at most 4 MiB.
+    const std::int64_t window_planes = window_range_planes(grid);
+    std::int64_t split = n == 1 ? 1 : std::clamp<std::int64_t>(nz / 8, n, 8 * std::int64_t{n});
+    if (window_planes > 0) split = std::max(split, (nz + window_planes - 1) / window_planes);
+    const int ranges = static_cast<int>(std::min<std::int64_t>(split, std::numeric_limits<int>::max()));
+    const auto first_plane = [nz, ranges](int r) { return nz * r / ranges; };
+    // runs the extractor of range r: `extractor`, or one on the range's window
+    const auto with_extractor = [&](int r, const auto& work) {
+        if (window_planes == 0) return work(extractor);
+        Buffer<T> buffer; // a block the allocator keeps: the next range's window reuses it
+        const GridView<T> view = window(grid, first_plane(r), first_plane(r + 1), buffer);
+        return work(RangeExtractor<T>(view, iso, options));
+    };
     Ticker ticker(options.progress, 2 * nz);
 
     std::vector<int> order(static_cast<std::size_t>(ranges));
@@ -1574,7 +1586,9 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
     try {
         for_each_range(n, order, options.executor, ticker, [&](int r) {
-            counts[static_cast<std::size_t>(r)] = extractor.count(nz * r / ranges, nz * (r + 1) / ranges, 0.0, &ticker);
+            counts[static_cast<std::size_t>(r)] = with_extractor(r, [&](const RangeExtractor<T>& x) {
+                return x.count(first_plane(r), first_plane(r + 1), 0.0, &ticker);
+            });
         });
     } catch (const Error& e) {
         // a range names its own non-finite samples: say how many the whole grid has, and the first
@@ -1600,7 +1614,9 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     out.normals = options.normals ? mesh.normals.data() : nullptr;
     // largest first (bonsai, 2 threads: the plane order left one thread idle for most of a large range)
     for_each_range(n, emit_order(counts), options.executor, ticker, [&](int r) {
-        extractor.emit(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], out, &ticker);
+        with_extractor(r, [&](const RangeExtractor<T>& x) {
+            x.emit(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], out, &ticker);
+        });
     });
     if (ticker.cancelled()) throw_cancelled();
     ticker.finish();

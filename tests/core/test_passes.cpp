@@ -61,13 +61,17 @@ struct Layout {
 };
 
 /// count / scan / emit over the ranges [b[r], b[r + 1]), each range given only its slice of the
-/// output (element 0 of its arrays is its own first vertex and triangle).
+/// output (element 0 of its arrays is its own first vertex and triangle). `windowed`: each pass of
+/// each range reads the range's window() (one buffer, reused), not g.
 template <class T>
 Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, const std::vector<std::int64_t>& b,
-                 std::int64_t first_vertex = 0, std::int64_t first_triangle = 0, Layout layout = {})
+                 std::int64_t first_vertex = 0, std::int64_t first_triangle = 0, Layout layout = {},
+                 bool windowed = false)
 {
+    cmc33::Buffer<T> buffer;
+    const auto grid = [&](std::size_t r) { return windowed ? cmc33::window(g, b[r], b[r + 1], buffer) : g; };
     std::vector<RangeCounts> counts;
-    for (std::size_t r = 0; r + 1 < b.size(); ++r) counts.push_back(cmc33::count(g, iso, opt, b[r], b[r + 1]));
+    for (std::size_t r = 0; r + 1 < b.size(); ++r) counts.push_back(cmc33::count(grid(r), iso, opt, b[r], b[r + 1]));
     const std::vector<RangeOffsets> offsets = cmc33::scan(counts, first_vertex, first_triangle);
     Output o;
     o.first_vertex = first_vertex, o.first_triangle = first_triangle;
@@ -97,7 +101,7 @@ Output run_split(const GridView<T>& g, double iso, const ExtractOptions& opt, co
         s.reverse_winding = layout.reverse_winding;
         s.first_vertex = offsets[r].first_vertex;
         s.first_triangle = offsets[r].first_triangle;
-        cmc33::emit(g, iso, opt, counts[r], offsets[r], s);
+        cmc33::emit(grid(r), iso, opt, counts[r], offsets[r], s);
     }
     return o;
 }
@@ -472,6 +476,54 @@ TEST(Passes, ViewsWithAnyStridesAreReadInPlace)
     EXPECT_EQ(ms.triangles, mc.triangles);
     // and through the passes, split
     expect_same_mesh(mc, run_split(sub, 100.0, opt, {0, 5, 6, nz}), "strided split");
+}
+
+TEST(Passes, WindowsGiveTheSameBytesAsTheGridForEverySplit)
+{
+    // a double field stored in Fortran order (x slowest), with a non-identity frame
+    const cmc33::Index3 dims{9, 7, 11};
+    const Volume v = noise(dims, 17);
+    const GridView<double> dense = v.view<double>();
+    std::vector<double> fortran(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
+    for (std::int64_t k = 0; k < dims[2]; ++k)
+        for (std::int64_t j = 0; j < dims[1]; ++j)
+            for (std::int64_t i = 0; i < dims[0]; ++i)
+                fortran[static_cast<std::size_t>(k + dims[2] * (j + dims[1] * i))] = dense(i, j, k);
+    GridView<double> f = dense;
+    f.data = fortran.data();
+    f.strides = {dims[1] * dims[2], dims[2], 1};
+    f.spacing = {0.5, 2, 1.25};
+    f.origin = {-3, 1e3, 7};
+    EXPECT_EQ(cmc33::window_range_planes(dense), 0);
+    EXPECT_GE(cmc33::window_range_planes(f), 1);
+    EXPECT_EQ(cmc33::window_range_planes(f, 1), 1);
+    ExtractOptions opt;
+    opt.normals = true;
+    opt.threads = 1;
+    GridView<double> framed = dense;
+    framed.spacing = f.spacing, framed.origin = f.origin;
+    const cmc33::Mesh expected = cmc33::extract(framed, 0.1, opt);
+    ASSERT_GT(expected.triangle_count(), 100u);
+    for (const auto& split : splits(dims[2])) {
+        std::string name = "windows of split";
+        for (std::int64_t b : split) name += " " + std::to_string(b);
+        expect_same_mesh(expected, run_split(f, 0.1, opt, split, 0, 0, {}, true), name);
+        const Output o = run_split(f, 0.1, opt, split, 0, 0, {}, true), plain = run_split(framed, 0.1, opt, split);
+        EXPECT_TRUE(std::equal(o.ranges.begin(), o.ranges.end(), plain.ranges.begin())) << name;
+        EXPECT_EQ(o.edges, plain.edges) << name;
+    }
+    // extract() reads such a grid through windows, whatever the thread count
+    for (const int threads : {1, 2, 3}) {
+        opt.threads = threads;
+        const cmc33::Mesh m = cmc33::extract(f, 0.1, opt);
+        EXPECT_EQ(m.positions, expected.positions) << threads;
+        EXPECT_EQ(m.normals, expected.normals) << threads;
+        EXPECT_EQ(m.triangles, expected.triangles) << threads;
+    }
+    cmc33::Buffer<double> buffer;
+    for (const auto& [k0, k1] : {std::pair<std::int64_t, std::int64_t>{-1, 3}, {3, 3}, {5, 12}}) {
+        EXPECT_THROW(cmc33::window(f, k0, k1, buffer), cmc33::Error) << k0 << " " << k1;
+    }
 }
 
 /// The status f() throws, or nullopt when it returns.

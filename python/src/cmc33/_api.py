@@ -59,8 +59,9 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         axis, as in the files. The eight types int8 ... float64 (and bool) are read in place
         whatever the strides (C or Fortran order, ``vol[:, ::2, 10:200]``, negative steps);
         other types are converted first (a copy). The mesh is the same for every layout; the
-        extractor is fastest when the last axis is contiguous (Fortran order reads along the slow
-        axis, a few times slower: ``np.ascontiguousarray`` trades a copy for that time).
+        extractor is fastest when the last axis is contiguous. Otherwise (Fortran order) each
+        range of planes is first copied, with x contiguous, into a window of at most 4 MiB per
+        thread: about 3x the time of C order for bonsai 256^3 uint8 (5x read in place).
     iso : float
         The isovalue.
     spacing, origin : 3 floats, optional

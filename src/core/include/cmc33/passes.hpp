@@ -29,12 +29,14 @@
 /// checks that it writes exactly what count counted (Error{internal} otherwise, before writing
 /// outside the range's part). The samples must not change between the passes.
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <span>
 #include <vector>
 
 #include "cmc33/extract.hpp"
+#include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
 #include "cmc33/core_export.hpp"
 
@@ -147,5 +149,28 @@ CMC33_CORE_EXPORT std::vector<int> emit_order(std::span<const RangeCounts> range
 template <class T>
 CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out);
+
+/// count() and emit() read a grid an x row at a time. Where x is not the grid's contiguous axis (a
+/// Fortran-ordered array: each sample of a row in its own cache line), copying the planes a range
+/// reads into x-contiguous order first is several times faster; window() makes that copy for
+/// range [k0, k1): planes max(k0 - 1, 0) .. min(k1 + 1, nz - 1) (what count and emit read) into
+/// `buffer` (resized as needed: reuse it from range to range), and returns a view of them with the
+/// grid's dims, indices and frame. count() and emit() of that range give the same bytes through
+/// the view as through `grid`; no other plane may be read through it. The buffer holds
+/// (planes) * (nx * ny + 64 / sizeof(T)) samples (the planes padded by a cache line).
+/// @throws Error{invalid_argument} unless 0 <= k0 < k1 <= nz
+template <class T>
+CMC33_CORE_EXPORT GridView<T> window(const GridView<T>& grid, std::int64_t k0, std::int64_t k1, Buffer<T>& buffer);
+
+/// For callers that run the passes over ranges: 0 when count() and emit() read `grid` best in
+/// place (its x samples adjacent, stride 1), else the most planes a range may have for its
+/// window() to stay within `bytes` (at least 1; a window holds up to 3 planes more).
+template <class T>
+std::int64_t window_range_planes(const GridView<T>& grid, std::int64_t bytes = std::int64_t{4} << 20) noexcept
+{
+    if (grid.strides[0] == 1 || grid.nx() < 2) return 0;
+    const std::int64_t plane = (grid.nx() * grid.ny() + 64) * static_cast<std::int64_t>(sizeof(T));
+    return std::max<std::int64_t>(bytes / plane - 3, 1);
+}
 
 } // namespace cmc33
