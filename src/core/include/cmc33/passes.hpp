@@ -169,7 +169,7 @@ template <class T>
 std::int64_t window_range_planes(const GridView<T>& grid, std::int64_t bytes = std::int64_t{4} << 20) noexcept
 {
     if (grid.strides[0] == 1 || grid.nx() < 2) return 0;
-    const std::int64_t plane = (grid.nx() * grid.ny() + 64) * static_cast<std::int64_t>(sizeof(T));
+    const std::int64_t plane = grid.nx() * grid.ny() * static_cast<std::int64_t>(sizeof(T)) + 64; // as window() pads
     return std::max<std::int64_t>(bytes / plane - 3, 1);
 }
 
