@@ -6,14 +6,65 @@
 // through cmc33.marching_cubes: 0.50 s against 0.04 s with the padding).
 
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <cstdlib>
+#include <cstring>
 
 #include "cmc33/error.hpp"
 #include "cmc33/passes.hpp"
+#include "portability.hpp"
 #include "sample_types.hpp"
 
 namespace cmc33 {
+namespace {
+
+/// Transposes a square tile of 8 / S elements of S bytes, a row per word (element c of row r in
+/// bits 8 S c .. 8 S (c + 1) - 1): afterwards row r holds what was column r. Swaps of ever larger
+/// blocks between rows: 3 stages for bytes, each a shift, an xor and a mask per pair of rows.
+template <std::size_t S> CMC33_ALWAYS_INLINE void transpose_tile(std::uint64_t (&rows)[8 / S])
+{
+    constexpr int n = 8 / S;
+    for (int unit = 8 * S, step = 1; unit < 64; unit *= 2, step *= 2) {
+        std::uint64_t mask = 0;
+        for (int b = 0; b < 64; b += 2 * unit) mask |= ((std::uint64_t{1} << unit) - 1) << b;
+        for (int r0 = 0; r0 < n; r0 += 2 * step) // rows r and r + step of each group of 2 step
+            for (int r = r0; r < r0 + step; ++r) {
+                const std::uint64_t t = ((rows[r] >> unit) ^ rows[r + step]) & mask;
+                rows[r + step] ^= t;
+                rows[r] ^= t << unit;
+            }
+    }
+}
+
+/// Planes [lo, hi) of a grid whose z samples are adjacent (stride 1: Fortran order) into `to`
+/// (planes `plane` samples apart, rows nx apart), by tiles of n x n samples (n = 8 / sizeof(T))
+/// along x and z transposed in 64-bit words: one load and one store per n samples instead of one
+/// per sample. Samples past whole tiles go one by one.
+template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to)
+{
+    constexpr std::int64_t n = 8 / sizeof(T);
+    const std::int64_t nx = g.nx(), ny = g.ny(), planes = hi - lo, sx = g.strides[0], sy = g.strides[1];
+    const std::int64_t tiled_x = nx - nx % n, tiled_z = planes - planes % n;
+    for (std::int64_t j = 0; j < ny; ++j) {
+        const T* row = g.data + j * sy + lo; // sample (0, j, lo)
+        T* out = to + j * nx;
+        for (std::int64_t i0 = 0; i0 < tiled_x; i0 += n) {
+            for (std::int64_t k0 = 0; k0 < tiled_z; k0 += n) {
+                std::uint64_t words[n];
+                for (std::int64_t r = 0; r < n; ++r) std::memcpy(&words[r], row + (i0 + r) * sx + k0, 8);
+                transpose_tile<sizeof(T)>(words);
+                for (std::int64_t r = 0; r < n; ++r) std::memcpy(out + (k0 + r) * plane + i0, &words[r], 8);
+            }
+            for (std::int64_t i = i0; i < i0 + n; ++i)
+                for (std::int64_t k = tiled_z; k < planes; ++k) out[k * plane + i] = row[i * sx + k];
+        }
+        for (std::int64_t i = tiled_x; i < nx; ++i)
+            for (std::int64_t k = 0; k < planes; ++k) out[k * plane + i] = row[i * sx + k];
+    }
+}
+
+} // namespace
 
 template <class T> GridView<T> window(const GridView<T>& grid, std::int64_t k0, std::int64_t k1, Buffer<T>& buffer)
 {
@@ -36,6 +87,8 @@ template <class T> GridView<T> window(const GridView<T>& grid, std::int64_t k0, 
                 T* out = to + (k - lo) * plane + j * nx;
                 for (std::int64_t i = 0; i < nx; ++i) out[i] = from[i * sx];
             }
+    } else if (sz == 1 && sizeof(T) < 8 && std::endian::native == std::endian::little) {
+        copy_z_runs(grid, lo, hi, plane, to);
     } else if (az <= ay) {
         // z innermost (Fortran order): each (i, j) a run along z, 8 rows j at a time, whose lines
         // in every plane stay in cache while i runs

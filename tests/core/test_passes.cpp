@@ -3,6 +3,7 @@
 // byte; the per-vertex and per-triangle extras say where each element came from; progress,
 // cancellation and the caller's executor; views with any strides; misuse refused.
 
+#include <array>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -527,6 +528,45 @@ TEST(Passes, WindowsGiveTheSameBytesAsTheGridForEverySplit)
     cmc33::Buffer<double> buffer;
     for (const auto& [k0, k1] : {std::pair<std::int64_t, std::int64_t>{-1, 3}, {3, 3}, {5, 12}}) {
         EXPECT_THROW(cmc33::window(f, k0, k1, buffer), cmc33::Error) << k0 << " " << k1;
+    }
+}
+
+/// window() of every range of a grid of T laid out with strides `order` (the axis of each
+/// stride rank: {2, 1, 0} is Fortran order) holds each sample of the planes the range reads.
+template <class T> void expect_windows_hold_the_samples(std::array<int, 3> order)
+{
+    const cmc33::Index3 dims{13, 5, 19}; // not multiples of a tile (8 bytes)
+    std::vector<T> samples(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
+    GridView<T> g;
+    g.data = samples.data();
+    g.dims = dims;
+    std::int64_t stride = 1;
+    for (const int axis : order) g.strides[static_cast<std::size_t>(axis)] = stride, stride *= dims[static_cast<std::size_t>(axis)];
+    for (std::int64_t k = 0; k < dims[2]; ++k)
+        for (std::int64_t j = 0; j < dims[1]; ++j)
+            for (std::int64_t i = 0; i < dims[0]; ++i)
+                samples[static_cast<std::size_t>(g.offset(i, j, k))] = static_cast<T>((i * 7 + j * 31 + k * 11) % 120 - 50);
+    cmc33::Buffer<T> buffer;
+    for (std::int64_t k0 = 0; k0 < dims[2]; ++k0)
+        for (std::int64_t k1 = k0 + 1; k1 <= dims[2]; ++k1) {
+            const GridView<T> w = cmc33::window(g, k0, k1, buffer);
+            bool same = true;
+            for (std::int64_t k = std::max<std::int64_t>(k0 - 1, 0); k <= std::min(k1 + 1, dims[2] - 1); ++k)
+                for (std::int64_t j = 0; j < dims[1]; ++j)
+                    for (std::int64_t i = 0; i < dims[0]; ++i) same = same && w(i, j, k) == g(i, j, k);
+            EXPECT_TRUE(same) << "[" << k0 << ", " << k1 << ") of " << sizeof(T) << "-byte samples, strides ranked "
+                              << order[0] << order[1] << order[2];
+            EXPECT_EQ(w.strides[0], 1);
+        }
+}
+
+TEST(Passes, WindowsHoldTheSamplesOfEveryTypeAndLayout)
+{
+    for (const std::array<int, 3> order : {std::array<int, 3>{2, 1, 0}, {1, 2, 0}, {1, 0, 2}, {0, 1, 2}}) {
+        expect_windows_hold_the_samples<std::int8_t>(order);
+        expect_windows_hold_the_samples<std::uint16_t>(order);
+        expect_windows_hold_the_samples<float>(order);
+        expect_windows_hold_the_samples<double>(order);
     }
 }
 
