@@ -61,7 +61,7 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         other types are converted first (a copy). The mesh is the same for every layout; the
         extractor is fastest when the last axis is contiguous. Otherwise (Fortran order) each
         range of planes is first copied, with x contiguous, into a window of at most 4 MiB per
-        thread: about 3x the time of C order for bonsai 256^3 uint8 (5x read in place).
+        thread: about twice the time of C order for bonsai 256^3 uint8 (5x read in place).
     iso : float
         The isovalue.
     spacing, origin : 3 floats, optional
