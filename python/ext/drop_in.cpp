@@ -87,7 +87,7 @@ public:
         std::int64_t ranges = std::min(nz, std::clamp<std::int64_t>(nz / (n == 1 ? kPlanesPerRangeAlone : kPlanesPerRange), n,
                                                                   std::max<std::int64_t>(4 * n, kMinRanges)));
         // where x is not the contiguous axis (Fortran order), each range is read through a
-        // window() of at most 4 MiB (passes.hpp), one buffer per thread
+        // window() of about 4 MiB (passes.hpp), one buffer per thread
         const std::int64_t window_planes = window_range_planes(g_);
         if (window_planes > 0) ranges = std::max(ranges, (nz + window_planes - 1) / window_planes);
         const auto plane = [&](std::int64_t r) { return nz * r / ranges; };

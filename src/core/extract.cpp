@@ -1566,7 +1566,7 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     // More ranges than threads, taken in turn by whichever thread is free: a surface is seldom
     // spread evenly over the planes. Ranges of at least 8 planes keep the planes read twice (at
     // the ranges' ends) few; the mesh is the same for every split. Where x is not the contiguous
-    // axis, each range is read through a window() (passes.hpp) of at most 4 MiB.
+    // axis, each range is read through a window() (passes.hpp) of about 4 MiB (at least 3 planes).
     const std::int64_t window_planes = window_range_planes(grid);
     std::int64_t split = n == 1 ? 1 : std::clamp<std::int64_t>(nz / 8, n, 8 * std::int64_t{n});
     if (window_planes > 0) split = std::max(split, (nz + window_planes - 1) / window_planes);

@@ -60,7 +60,7 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         whatever the strides (C or Fortran order, ``vol[:, ::2, 10:200]``, negative steps);
         other types are converted first (a copy). The mesh is the same for every layout; the
         extractor is fastest when the last axis is contiguous. Otherwise (Fortran order) each
-        range of planes is first copied, with x contiguous, into a window of at most 4 MiB per
+        range of planes is first copied, with x contiguous, into a window of about 4 MiB per
         thread: about twice the time of C order for bonsai 256^3 uint8 (5x read in place).
     iso : float
         The isovalue.

@@ -49,7 +49,7 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
         other types are converted first (float16 to float32; int64, uint64 to float64). The
         arrays returned are the same for every layout; C order (last axis contiguous) is the
         fast one. Where the last axis is not contiguous (Fortran order), each range of planes is
-        first copied, with x contiguous, into a window of at most 4 MiB per thread (about 2x the
+        first copied, with x contiguous, into a window of about 4 MiB per thread (about 2x the
         time of C order for bonsai 256^3 uint8, instead of 5x read in place).
     level : float, optional
         The isovalue; default the middle of the data range, ``(min + max) / 2``. A value outside
