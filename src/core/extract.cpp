@@ -335,7 +335,7 @@ template <class Task> void run_tasks(int n, const Executor& executor, Task&& tas
     }
 }
 
-/// Runs work(r) for every range r of `order` (a permutation of 0..ranges-1) on n tasks of
+/// Runs work(r, t) for every range r of `order` (a permutation of 0..ranges-1) on n tasks t of
 /// run_tasks, each taking the next range of `order` not yet taken, until none is left or the
 /// ticker says stop; rethrows the error of the lowest range that failed, so that the error does
 /// not depend on which thread ran which range.
@@ -345,11 +345,11 @@ void for_each_range(int n, std::span<const int> order, const Executor& executor,
     const int ranges = static_cast<int>(order.size());
     std::vector<std::exception_ptr> errors(order.size());
     std::atomic<int> next{0};
-    run_tasks(n, executor, [&](int) {
+    run_tasks(n, executor, [&](int task) {
         for (int taken = next.fetch_add(1); taken < ranges && !ticker.cancelled(); taken = next.fetch_add(1)) {
             const int r = order[static_cast<std::size_t>(taken)];
             try {
-                work(r);
+                work(r, task);
             } catch (...) {
                 errors[static_cast<std::size_t>(r)] = std::current_exception();
             }
@@ -1572,11 +1572,12 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     if (window_planes > 0) split = std::max(split, (nz + window_planes - 1) / window_planes);
     const int ranges = static_cast<int>(std::min<std::int64_t>(split, std::numeric_limits<int>::max()));
     const auto first_plane = [nz, ranges](int r) { return nz * r / ranges; };
-    // runs the extractor of range r: `extractor`, or one on the range's window
-    const auto with_extractor = [&](int r, const auto& work) {
+    // runs work on the extractor of range r: `extractor`, or one on the range's window in task t's
+    // buffer (an extractor's tables take microseconds, a window's copy milliseconds)
+    std::vector<Buffer<T>> windows(static_cast<std::size_t>(window_planes > 0 ? n : 0));
+    const auto with_extractor = [&](int r, int t, const auto& work) {
         if (window_planes == 0) return work(extractor);
-        Buffer<T> buffer; // a block the allocator keeps: the next range's window reuses it
-        const GridView<T> view = window(grid, first_plane(r), first_plane(r + 1), buffer);
+        const GridView<T> view = window(grid, first_plane(r), first_plane(r + 1), windows[static_cast<std::size_t>(t)]);
         return work(RangeExtractor<T>(view, iso, options));
     };
     Ticker ticker(options.progress, 2 * nz);
@@ -1585,8 +1586,8 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     std::iota(order.begin(), order.end(), 0);
     std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
     try {
-        for_each_range(n, order, options.executor, ticker, [&](int r) {
-            counts[static_cast<std::size_t>(r)] = with_extractor(r, [&](const RangeExtractor<T>& x) {
+        for_each_range(n, order, options.executor, ticker, [&](int r, int t) {
+            counts[static_cast<std::size_t>(r)] = with_extractor(r, t, [&](const RangeExtractor<T>& x) {
                 return x.count(first_plane(r), first_plane(r + 1), 0.0, &ticker);
             });
         });
@@ -1613,8 +1614,8 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     out.triangles = mesh.triangles.data();
     out.normals = options.normals ? mesh.normals.data() : nullptr;
     // largest first (bonsai, 2 threads: the plane order left one thread idle for most of a large range)
-    for_each_range(n, emit_order(counts), options.executor, ticker, [&](int r) {
-        with_extractor(r, [&](const RangeExtractor<T>& x) {
+    for_each_range(n, emit_order(counts), options.executor, ticker, [&](int r, int t) {
+        with_extractor(r, t, [&](const RangeExtractor<T>& x) {
             x.emit(counts[static_cast<std::size_t>(r)], offsets[static_cast<std::size_t>(r)], out, &ticker);
         });
     });

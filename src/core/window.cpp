@@ -75,7 +75,7 @@ template <class T> GridView<T> window(const GridView<T>& grid, std::int64_t k0, 
                                                   ") are not a range of the grid's " + std::to_string(nz));
     }
     const std::int64_t lo = std::max<std::int64_t>(k0 - 1, 0), hi = std::min(k1 + 2, nz);
-    const std::int64_t plane = nx * ny + std::max<std::int64_t>(64 / static_cast<std::int64_t>(sizeof(T)), 1);
+    const std::int64_t plane = nx * ny + detail::kWindowPad<T>;
     buffer.resize(static_cast<std::size_t>((hi - lo) * plane));
     T* const to = buffer.data();
     const std::int64_t sx = grid.strides[0], sy = grid.strides[1], sz = grid.strides[2];

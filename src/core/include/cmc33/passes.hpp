@@ -150,6 +150,11 @@ template <class T>
 CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out);
 
+namespace detail {
+/// window()'s planes are this many samples longer than nx * ny: a cache line (see window.cpp).
+template <class T> inline constexpr std::int64_t kWindowPad = 64 / static_cast<std::int64_t>(sizeof(T));
+} // namespace detail
+
 /// count() and emit() read a grid an x row at a time. Where x is not the grid's contiguous axis (a
 /// Fortran-ordered array: each sample of a row in its own cache line), copying the planes a range
 /// reads into x-contiguous order first is several times faster; window() makes that copy for
@@ -169,7 +174,7 @@ template <class T>
 std::int64_t window_range_planes(const GridView<T>& grid, std::int64_t bytes = std::int64_t{4} << 20) noexcept
 {
     if (grid.strides[0] == 1 || grid.nx() < 2) return 0;
-    const std::int64_t plane = grid.nx() * grid.ny() * static_cast<std::int64_t>(sizeof(T)) + 64; // as window() pads
+    const std::int64_t plane = (grid.nx() * grid.ny() + detail::kWindowPad<T>) * static_cast<std::int64_t>(sizeof(T));
     return std::max<std::int64_t>(bytes / plane - 3, 1);
 }
 
