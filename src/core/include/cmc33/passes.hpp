@@ -74,7 +74,9 @@ private:
     double largest_sample_ = 0;            ///< bound on |sample| near the range (normals' scaling)
     double iso_ = 0;                       ///< the isovalue and method counted (emit checks them)
     Method method_ = Method::cmc33;
-    std::vector<Row> rows_;                ///< (k1 - k0) * ny rows, row (j, k) at j + (k - k0) * ny
+    /// (k1 - k0) * ny rows, row (j, k) at j + (k - k0) * ny. A Buffer (mesh.hpp), as the mesh is: its
+    /// megabytes (1.5 MiB for 256^3) come in huge pages, kept for the next count of the same size.
+    Buffer<Row> rows_;
     std::vector<std::int64_t> seam_first_; ///< plane k1's rows: first x/y edge vertex (next range's ids)
     /// One byte per cell with a face or interior test, in the order count met them: its decision,
     /// which emit replays instead of deciding again
