@@ -1238,13 +1238,16 @@ private:
         // cube edge q of the cell at i has its vertex id at edge_ids[q][3 * i]
         // (codes 12.. are interior vertices, never looked up here; their entries point into the
         // rows too, so that the fixed-width copy of a short tiling below may read the codes past
-        // its end: it writes them into ids that the row's next cells overwrite)
+        // its end: it writes them into ids that the next cells overwrite)
         const std::uint32_t* edge_ids[12 + detail::kMaxInteriorVertices];
         for (std::size_t q = 0; q < 12; ++q) edge_ids[q] = ids[kEdgeRow[q]] + kEdgeSlot[q];
         for (std::size_t q = 12; q < std::size(edge_ids); ++q) edge_ids[q] = ids[0];
         const Word *f00 = rows[0], *f10 = rows[1], *f01 = rows[2], *f11 = rows[3];
         const MeshSpans& out = e.out;
-        const std::int64_t row_end = e.off.first_triangle + r.t1;
+        // a short tiling's fixed-size copy may write past its row's triangles into those of the
+        // range's next rows, which this thread writes later, but not past the range's (another
+        // thread's, or the caller's end of the output)
+        const std::int64_t copy_end = e.off.first_triangle + e.c.triangles_;
         const std::uint8_t* const padded_table = padded_codes().data();
         const bool flip = kOut != Outputs::plain ? mirrored_ != out.reverse_winding : mirrored_;
         // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
@@ -1266,15 +1269,15 @@ private:
             const auto t0 = static_cast<std::size_t>(tri - out.first_triangle);
             std::uint32_t* o = &out.triangles[t0 * 3];
             int count = short_count_[code]; // triangles written
-            if (count >= 0 && tri + kShortTiling <= row_end) {
+            if (count >= 0 && tri + kShortTiling <= copy_end) {
                 // most cells: a fixed short tiling, 3 * kShortTiling ids, the ones past the
-                // tiling overwritten by the row's next cells (no loop whose length the branch
-                // predictor has to guess); row_end bounds the triangles
+                // tiling overwritten by the next cells (no loop whose length the branch
+                // predictor has to guess); copy_end bounds the triangles
                 const std::int32_t* offset = short_offsets + static_cast<std::size_t>(code) * 3 * kShortTiling;
                 const std::uint32_t* at = id_base + 3 * i;
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = at[offset[q]];
             } else {
-                count = emit_cell(i, j, k, code, edge_ids, padded_table, row_end, r, e, tri, o, vertex, decision);
+                count = emit_cell(i, j, k, code, edge_ids, padded_table, copy_end, r, e, tri, o, vertex, decision);
             }
             if (flip) {
                 for (int q = 0; q < 3 * count; q += 3) std::swap(o[q + 1], o[q + 2]);
@@ -1295,7 +1298,7 @@ private:
     /// fixed one (the caller's); tested cells replay count's next decision. Returns the number of
     /// triangles.
     int emit_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, const std::uint32_t* const* edge_ids,
-                  const std::uint8_t* padded_table, std::int64_t row_end, const RowSpan& r, const Emit& e,
+                  const std::uint8_t* padded_table, std::int64_t copy_end, const RowSpan& r, const Emit& e,
                   std::int64_t tri, std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
     {
         const std::vector<std::uint8_t>& decisions = e.c.decisions_;
@@ -1311,7 +1314,7 @@ private:
         const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
         const int n = 3 * tl->triangle_count;
         if (tl->interior_count == 0) {
-            if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= row_end) {
+            if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= copy_end) {
                 // as for the fixed short tilings in emit_row_cells
                 const std::uint8_t* padded = &padded_table[static_cast<std::size_t>(tl->first_triangle) * 3];
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = edge_ids[padded[q]][3 * i];
