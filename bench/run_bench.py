@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """The one-invocation comparison of cmc33 with its peers, as their users run them (bench/README.md).
 
-    bench/run_bench.py [--repeat R] [--cases a,b,...] [--quick] [--out DIR] [--volumes DIR]
-                       [--build DIR] [--work DIR] [--no-skimage]
+    bench/run_bench.py [--repeat R] [--rounds N] [--pin CPU] [--cases a,b,...] [--quick] [--out DIR]
+                       [--volumes DIR] [--build DIR] [--work DIR] [--no-skimage]
 
 Builds cmc33 (Release, -DCMC33_BUILD_BENCH=ON), makes the synthetic volumes, and on every case runs,
 each in its own process under GNU time (peak memory):
@@ -101,10 +101,23 @@ def main(argv):
     p.add_argument("--work", default=os.path.join(REPO, "bench-work"),
                    help="where the synthetic volumes are made and kept (default bench-work)")
     p.add_argument("--no-skimage", action="store_true", help="leave scikit-image out (its runs are the slow ones)")
+    p.add_argument("--rounds", type=int, default=1,
+                   help="run every tool of a case this many times, the tools taking turns, and report the median "
+                        "of the rounds' medians (default 1): on a VM whose speed drifts, every tool samples the "
+                        "same drift")
+    p.add_argument("--pin", type=int, metavar="CPU",
+                   help="run the one-thread runs of every tool under taskset -c CPU (the same CPU for all tools: "
+                        "on a VM whose vCPUs differ in speed, they compare on one)")
     args = p.parse_args(argv)
     repeat = args.repeat if args.repeat is not None else (1 if args.quick else 5)
     if not 1 <= repeat <= 1000:
         p.error(f"--repeat {repeat} is not an integer in [1, 1000]")
+    if not 1 <= args.rounds <= 100:
+        p.error(f"--rounds {args.rounds} is not an integer in [1, 100]")
+    if args.pin is not None and not 0 <= args.pin < (os.cpu_count() or 1):
+        p.error(f"--pin {args.pin} is not a CPU of this machine (0 to {(os.cpu_count() or 1) - 1})")
+    if args.pin is not None and shutil.which("taskset") is None:
+        p.error("--pin needs taskset (Debian: util-linux)")
     cases = list(CASES) if not args.cases else [c.strip() for c in args.cases.split(",") if c.strip()]
     for c in cases:
         if c not in CASES:
@@ -186,7 +199,7 @@ def main(argv):
     failed = 0
     tmp = tempfile.mkdtemp()
     try:
-        total = len(cases) * (len(runs) + 1)
+        total = len(cases) * (args.rounds * len(runs) + 1)
         step = 0
         for c in cases:
             f, iso = files[c], CASES[c][1]
@@ -203,7 +216,8 @@ def main(argv):
             records.append(dict(base, tool="floor", **(floor or {"error": err})))
             print(f"hot {floor['hot_seconds'] * 1e3:.2f} ms, cold {floor['cold_seconds'] * 1e3:.2f} ms"
                   if floor else f"FAILED: {err}", file=sys.stderr)
-            for tool, threads, normals in runs:
+            done = {}  # (tool, threads, normals) -> the record of its rounds so far
+            for rnd, (tool, threads, normals) in [(n, run) for n in range(args.rounds) for run in runs]:
                 step += 1
                 if tool == "cmc33":
                     cmd = [cmc33, "extract", f, "--iso", repr(iso), "--json", "--no-topology", "--quiet",
@@ -213,28 +227,42 @@ def main(argv):
                            "--threads", str(threads)] + ([] if normals else ["--no-normals"])
                 else:
                     cmd = [python, os.path.join(BENCH, "skimage_bench.py"), f, repr(iso), "--repeat", str(repeat)]
+                if args.pin is not None and threads == 1:
+                    cmd = ["taskset", "-c", str(args.pin)] + cmd
                 label = f"{tool} {'all' if threads == 0 else threads}t {'normals' if normals else 'no normals'}"
-                print(f"{PROG}: [{step}/{total}] {c:12} {label:28}", file=sys.stderr, end=" ")
+                if args.rounds > 1:
+                    label += f" r{rnd + 1}"
+                print(f"{PROG}: [{step}/{total}] {c:12} {label:31}", file=sys.stderr, end=" ")
                 r, rss, err = run_tool(cmd, tmp)
-                rec = dict(base, tool=tool, normals=normals, requested_threads=threads, peak_rss_kib=rss)
+                rec = done.get((tool, threads, normals))
+                if rec is None:
+                    rec = done[(tool, threads, normals)] = dict(base, tool=tool, normals=normals, requested_threads=threads,
+                                                                peak_rss_kib=rss, rounds_seconds=[], runs_seconds=[])
+                    records.append(rec)
+                if rss is not None:
+                    rec["peak_rss_kib"] = max(rec["peak_rss_kib"] or 0, rss)
                 if err:
-                    failed += 1
+                    if "error" not in rec:
+                        failed += 1
                     rec["error"] = err
                     print(f"FAILED: {err}", file=sys.stderr)
-                else:
-                    rec.update({k: r[k] for k in ("seconds", "runs_seconds", "vertices", "triangles", "threads") if k in r})
-                    for k in ("smp_backend", "vtk_version", "version", "numpy_version"):
-                        if k in r:
-                            rec[k] = r[k]
-                    print(f"{r['seconds'] * 1e3:.1f} ms, {r['triangles']} triangles, "
-                          f"{(rss or 0) / 1024:.0f} MiB peak", file=sys.stderr)
-                records.append(rec)
+                    continue
+                rec["rounds_seconds"].append(r["seconds"])
+                rec["runs_seconds"] += r.get("runs_seconds", [])
+                rec["seconds"] = statistics.median(rec["rounds_seconds"])
+                rec.update({k: r[k] for k in ("vertices", "triangles", "threads") if k in r})
+                for k in ("smp_backend", "vtk_version", "version", "numpy_version"):
+                    if k in r:
+                        rec[k] = r[k]
+                print(f"{r['seconds'] * 1e3:.1f} ms, {r['triangles']} triangles, "
+                      f"{(rss or 0) / 1024:.0f} MiB peak", file=sys.stderr)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     with open(results_path, "w") as fp:
         for rec in records:
             fp.write(json.dumps(rec) + "\n")
     meta = machine(args.build, repeat, args.quick, nproc)
+    meta.update(rounds=args.rounds, pin=args.pin)
     text = tables(records, cases, meta, notes)
     with open(os.path.join(out, "results.md"), "w") as fp:
         fp.write(text)
@@ -297,6 +325,10 @@ def tables(records, cases, meta, notes):
     lines += [f"- date: {meta['date']}; machine: {meta['cpu']}, {meta['nproc']} logical CPUs",
               f"- commit {meta['commit']}, {meta['compiler']}, Release",
               f"- every figure: the median of {meta['repeat']} extractions (file reading excluded), each tool in its own process"]
+    if meta.get("rounds", 1) > 1:
+        lines += [f"- {meta['rounds']} rounds, the tools of a case taking turns: every figure is the median of the rounds' medians"]
+    if meta.get("pin") is not None:
+        lines += [f"- one-thread runs of every tool pinned to CPU {meta['pin']} (taskset -c {meta['pin']})"]
     if vtk:
         lines.append(f"- VTK {vtk['vtk_version']} through its Python wrapping, vtkSMPTools backend {vtk['smp_backend']}")
     if ski:
