@@ -22,6 +22,7 @@
 #include <exception>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cmc33/error.hpp"
@@ -51,8 +52,10 @@ double seconds_since(std::chrono::steady_clock::time_point start)
 template <class T> void time_passes(const cmc33::GridView<T>& grid, double iso, const cmc33::ExtractOptions& options, Times& times)
 {
     const auto start = std::chrono::steady_clock::now();
-    const std::vector<cmc33::RangeCounts> counts{cmc33::count(grid, iso, options, 0, grid.nz())};
+    cmc33::RangeCounts counted = cmc33::count(grid, iso, options, 0, grid.nz());
     times.count.push_back(seconds_since(start));
+    std::vector<cmc33::RangeCounts> counts;
+    counts.push_back(std::move(counted)); // not a copy of the rows (an initializer list copies)
     const std::vector<cmc33::RangeOffsets> offsets = cmc33::scan(counts, 0, 0);
     times.vertices = counts[0].vertex_count();
     times.triangles = counts[0].triangle_count();

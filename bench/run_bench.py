@@ -245,11 +245,13 @@ def main(argv):
                     if "error" not in rec:
                         failed += 1
                     rec["error"] = err
+                    rec.pop("seconds", None)  # a tool that failed in any round is marked failed in the table
                     print(f"FAILED: {err}", file=sys.stderr)
                     continue
                 rec["rounds_seconds"].append(r["seconds"])
                 rec["runs_seconds"] += r.get("runs_seconds", [])
-                rec["seconds"] = statistics.median(rec["rounds_seconds"])
+                if "error" not in rec:
+                    rec["seconds"] = statistics.median(rec["rounds_seconds"])
                 rec.update({k: r[k] for k in ("vertices", "triangles", "threads") if k in r})
                 for k in ("smp_backend", "vtk_version", "version", "numpy_version"):
                     if k in r:
