@@ -237,7 +237,7 @@ def main(argv):
                 rec = done.get((tool, threads, normals))
                 if rec is None:
                     rec = done[(tool, threads, normals)] = dict(base, tool=tool, normals=normals, requested_threads=threads,
-                                                                peak_rss_kib=rss, rounds_seconds=[], runs_seconds=[])
+                                                                peak_rss_kib=None, rounds_seconds=[], runs_seconds=[])
                     records.append(rec)
                 if rss is not None:
                     rec["peak_rss_kib"] = max(rec["peak_rss_kib"] or 0, rss)

@@ -582,6 +582,10 @@ private:
         const RangeOffsets& off;
         const MeshSpans& out;
         double gradient_scale;
+        /// One past the range's last triangle id: a short tiling's fixed-size copy may write past
+        /// its row's triangles into those of the range's next rows, which this thread writes
+        /// later, but not past the range's (another thread's, or the end of the caller's output).
+        std::int64_t copy_end() const { return off.first_triangle + c.triangles_; }
     };
 
     /// One thread's working memory: above-flags of three slices (3 nx ny / 8 bytes), vertex ids
@@ -1244,10 +1248,7 @@ private:
         for (std::size_t q = 12; q < std::size(edge_ids); ++q) edge_ids[q] = ids[0];
         const Word *f00 = rows[0], *f10 = rows[1], *f01 = rows[2], *f11 = rows[3];
         const MeshSpans& out = e.out;
-        // a short tiling's fixed-size copy may write past its row's triangles into those of the
-        // range's next rows, which this thread writes later, but not past the range's (another
-        // thread's, or the caller's end of the output)
-        const std::int64_t copy_end = e.off.first_triangle + e.c.triangles_;
+        const std::int64_t copy_end = e.copy_end();
         const std::uint8_t* const padded_table = padded_codes().data();
         const bool flip = kOut != Outputs::plain ? mirrored_ != out.reverse_winding : mirrored_;
         // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
@@ -1277,7 +1278,7 @@ private:
                 const std::uint32_t* at = id_base + 3 * i;
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = at[offset[q]];
             } else {
-                count = emit_cell(i, j, k, code, edge_ids, padded_table, copy_end, r, e, tri, o, vertex, decision);
+                count = emit_cell(i, j, k, code, edge_ids, padded_table, r, e, tri, o, vertex, decision);
             }
             if (flip) {
                 for (int q = 0; q < 3 * count; q += 3) std::swap(o[q + 1], o[q + 2]);
@@ -1298,7 +1299,7 @@ private:
     /// fixed one (the caller's); tested cells replay count's next decision. Returns the number of
     /// triangles.
     int emit_cell(std::int64_t i, std::int64_t j, std::int64_t k, unsigned code, const std::uint32_t* const* edge_ids,
-                  const std::uint8_t* padded_table, std::int64_t copy_end, const RowSpan& r, const Emit& e,
+                  const std::uint8_t* padded_table, const RowSpan& r, const Emit& e,
                   std::int64_t tri, std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
     {
         const std::vector<std::uint8_t>& decisions = e.c.decisions_;
@@ -1314,7 +1315,7 @@ private:
         const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl->first_triangle) * 3];
         const int n = 3 * tl->triangle_count;
         if (tl->interior_count == 0) {
-            if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= copy_end) {
+            if (tl->triangle_count <= kShortTiling && tri + kShortTiling <= e.copy_end()) {
                 // as for the fixed short tilings in emit_row_cells
                 const std::uint8_t* padded = &padded_table[static_cast<std::size_t>(tl->first_triangle) * 3];
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = edge_ids[padded[q]][3 * i];
