@@ -33,6 +33,13 @@
 #define CMC33_ALWAYS_INLINE inline
 #endif
 
+/// A hint to fetch the cache line at address p (read); nothing where the compiler has no such hint.
+#if defined(__GNUC__) || defined(__clang__)
+#define CMC33_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define CMC33_PREFETCH(p) ((void)(p))
+#endif
+
 namespace cmc33::detail {
 
 #if defined(__SIZEOF_INT128__)
