@@ -41,16 +41,24 @@ template <std::size_t S> CMC33_ALWAYS_INLINE void transpose_tile(std::uint64_t (
 /// Planes [lo, hi) of a grid whose z samples are adjacent (stride 1: Fortran order) into `to`
 /// (planes `plane` samples apart, rows nx apart), by tiles of n x n samples (n = 8 / sizeof(T))
 /// along x and z transposed in 64-bit words: one load and one store per n samples instead of one
-/// per sample. Samples past whole tiles go one by one.
+/// per sample. Samples past whole tiles go one by one. The runs kAhead samples on along x are
+/// fetched ahead: they lie a plane of the grid apart, which the hardware does not fetch ahead
+/// (bonsai 256^3 through cmc33.marching_cubes, one thread: float32 114 -> 84 ms, int16 80 -> 69
+/// ms, uint8 55 -> 52 ms; 32 runs ahead was no faster).
 template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to)
 {
     constexpr std::int64_t n = 8 / sizeof(T);
+    constexpr std::int64_t kAhead = 16; // runs (x) fetched ahead of the tile
     const std::int64_t nx = g.nx(), ny = g.ny(), planes = hi - lo, sx = g.strides[0], sy = g.strides[1];
     const std::int64_t tiled_x = nx - nx % n, tiled_z = planes - planes % n;
     for (std::int64_t j = 0; j < ny; ++j) {
         const T* row = g.data + j * sy + lo; // sample (0, j, lo)
         T* out = to + j * nx;
         for (std::int64_t i0 = 0; i0 < tiled_x; i0 += n) {
+            for (std::int64_t i = i0 + kAhead; i < std::min(i0 + kAhead + n, nx); ++i) {
+                CMC33_PREFETCH(row + i * sx);
+                CMC33_PREFETCH(row + i * sx + planes - 1);
+            }
             for (std::int64_t k0 = 0; k0 < tiled_z; k0 += n) {
                 std::uint64_t words[n];
                 for (std::int64_t r = 0; r < n; ++r) std::memcpy(&words[r], row + (i0 + r) * sx + k0, 8);
