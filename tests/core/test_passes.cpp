@@ -531,11 +531,11 @@ TEST(Passes, WindowsGiveTheSameBytesAsTheGridForEverySplit)
     }
 }
 
-/// window() of every range of a grid of T laid out with strides `order` (the axis of each
-/// stride rank: {2, 1, 0} is Fortran order) holds each sample of the planes the range reads.
-template <class T> void expect_windows_hold_the_samples(std::array<int, 3> order)
+/// window() of every range of a grid of T with dimensions `dims` laid out with strides `order` (the
+/// axis of each stride rank: {2, 1, 0} is Fortran order) holds each sample of the planes the range
+/// reads.
+template <class T> void expect_windows_hold_the_samples(std::array<int, 3> order, cmc33::Index3 dims)
 {
-    const cmc33::Index3 dims{13, 5, 19}; // not multiples of a tile (8 bytes)
     std::vector<T> samples(static_cast<std::size_t>(dims[0] * dims[1] * dims[2]));
     GridView<T> g;
     g.data = samples.data();
@@ -563,10 +563,14 @@ template <class T> void expect_windows_hold_the_samples(std::array<int, 3> order
 TEST(Passes, WindowsHoldTheSamplesOfEveryTypeAndLayout)
 {
     for (const std::array<int, 3> order : {std::array<int, 3>{2, 1, 0}, {1, 2, 0}, {1, 0, 2}, {0, 1, 2}}) {
-        expect_windows_hold_the_samples<std::int8_t>(order);
-        expect_windows_hold_the_samples<std::uint16_t>(order);
-        expect_windows_hold_the_samples<float>(order);
-        expect_windows_hold_the_samples<double>(order);
+        // not multiples of a tile (8 bytes, or a cache line); then several tiles along x and the
+        // rows fetched ahead of them
+        for (const cmc33::Index3 dims : {cmc33::Index3{13, 5, 19}, cmc33::Index3{70, 9, 21}}) {
+            expect_windows_hold_the_samples<std::int8_t>(order, dims);
+            expect_windows_hold_the_samples<std::uint16_t>(order, dims);
+            expect_windows_hold_the_samples<float>(order, dims);
+            expect_windows_hold_the_samples<double>(order, dims);
+        }
     }
 }
 
