@@ -245,13 +245,10 @@ def main(argv):
                     if "error" not in rec:
                         failed += 1
                     rec["error"] = err
-                    rec.pop("seconds", None)  # a tool that failed in any round is marked failed in the table
                     print(f"FAILED: {err}", file=sys.stderr)
                     continue
                 rec["rounds_seconds"].append(r["seconds"])
                 rec["runs_seconds"] += r.get("runs_seconds", [])
-                if "error" not in rec:
-                    rec["seconds"] = statistics.median(rec["rounds_seconds"])
                 rec.update({k: r[k] for k in ("vertices", "triangles", "threads") if k in r})
                 for k in ("smp_backend", "vtk_version", "version", "numpy_version"):
                     if k in r:
@@ -260,6 +257,10 @@ def main(argv):
                       f"{(rss or 0) / 1024:.0f} MiB peak", file=sys.stderr)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+    for rec in records:
+        # the median of the rounds' medians; a tool that failed in any round is marked failed in the table
+        if rec.get("rounds_seconds") and "error" not in rec:
+            rec["seconds"] = statistics.median(rec["rounds_seconds"])
     with open(results_path, "w") as fp:
         for rec in records:
             fp.write(json.dumps(rec) + "\n")

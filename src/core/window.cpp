@@ -73,7 +73,7 @@ template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::
     }
 }
 
-/// Planes [lo, hi) of a grid whose smallest stride is along `inner` (1: y, 2: z) into `to` (planes
+/// Planes [lo, hi) of a grid whose smallest stride is along z (`z_inner`) or y into `to` (planes
 /// `plane` samples apart, rows nx apart): the (x, inner) squares transposed in tiles of n x n
 /// samples (n a cache line's worth, at least 8), so that each line a tile reads (one per x) and
 /// writes (one per inner sample) is used whole. x tiles outermost, then the rows of the third
@@ -83,12 +83,11 @@ template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::
 /// at a time: float64 Fortran order 257 -> 139 ms, y innermost int16 148 -> 48 ms, float64
 /// 366 -> 96 ms; C order 40 ms.)
 template <class T>
-void copy_tiles(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to, int inner)
+void copy_tiles(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to, bool z_inner)
 {
     constexpr std::int64_t n = std::max<std::int64_t>(8, 64 / sizeof(T));
     constexpr std::int64_t kAhead = 4; // rows of the outer axis whose lines are fetched ahead
     const std::int64_t nx = g.nx(), ny = g.ny(), sx = g.strides[0], sy = g.strides[1], sz = g.strides[2];
-    const bool z_inner = inner == 2;
     const std::int64_t inner_n = z_inner ? hi - lo : ny, outer_n = z_inner ? ny : hi - lo;
     const std::int64_t from_inner = z_inner ? sz : sy, to_inner = z_inner ? plane : nx;
     const std::int64_t from_outer = z_inner ? sy : sz, to_outer = z_inner ? nx : plane;
@@ -139,7 +138,7 @@ template <class T> GridView<T> window(const GridView<T>& grid, std::int64_t k0, 
     } else if (sz == 1 && sizeof(T) < 8 && std::endian::native == std::endian::little) {
         copy_z_runs(grid, lo, hi, plane, to);
     } else {
-        copy_tiles(grid, lo, hi, plane, to, az <= ay ? 2 : 1);
+        copy_tiles(grid, lo, hi, plane, to, az <= ay);
     }
     // The view's data pointer stands for sample (0, 0, 0), which lies before the buffer (an
     // address computed as an integer): only planes lo .. hi - 1 are ever read through it.
