@@ -415,7 +415,14 @@ public:
         c.rows_.assign(static_cast<std::size_t>((k1 - k0) * ny_), {});
         Scratch s(nx_, ny_);
         for (std::int64_t k = k0; k < k1; ++k) {
-            for (std::int64_t j = 0; j < ny_; ++j) count_row(j, k, s, c);
+            const Word* rows[4];
+            detail::RowSigns signs[4];
+            flags_around(0, k, s, rows, signs);
+            for (std::int64_t j = 0;;) {
+                count_row(j, k, s, c, rows, signs);
+                if (++j == ny_) break;
+                next_flags_around(j, k, s, rows, signs);
+            }
             if (ticker && !ticker->tick()) return c;
         }
         if (k1 < nz_) {
@@ -750,6 +757,21 @@ private:
         if (j + 1 < ny_ && k + 1 < nz_) f[3] = flags(j + 1, k + 1, s, signs[3]);
     }
 
+    /// flags_around(j, k) from flags_around(j - 1, k) in `f` and `signs`: rows (j, k) and (j, k + 1)
+    /// are already there (the pass over a plane fetches two rows per cell row, not four).
+    CMC33_ALWAYS_INLINE void next_flags_around(std::int64_t j, std::int64_t k, Scratch& s, const Word* (&f)[4],
+                                               detail::RowSigns (&signs)[4]) const
+    {
+        const bool up = k + 1 < nz_;
+        const Word* above = up ? f[3] : f[1]; // (j, k + 1), or (j, k) past the grid
+        const detail::RowSigns above_signs = up ? signs[3] : signs[1];
+        f[0] = f[1] = f[3] = f[1];
+        signs[0] = signs[1] = signs[3] = signs[1];
+        f[2] = above, signs[2] = above_signs;
+        if (j + 1 < ny_) f[1] = flags(j + 1, k, s, signs[1]);
+        if (j + 1 < ny_ && up) f[3] = flags(j + 1, k + 1, s, signs[3]);
+    }
+
     /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
     /// where the edge does not cross or does not exist (or, in the next range's plane k1, for the z
     /// edges, which no cell of this range uses). `interior`: the id after the row's last z edge
@@ -894,13 +916,12 @@ private:
 
     /// Counts row (j, k) into its Row of `c`: x/y edge vertices in xy_first, z edge and interior
     /// vertices in z_first, triangles in triangle_first (count() turns them into first ids).
-    CMC33_ALWAYS_INLINE void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c) const
+    /// `rows` and `signs`: flags_around(j, k).
+    CMC33_ALWAYS_INLINE void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c,
+                                       const Word* const (&rows)[4], const detail::RowSigns (&signs)[4]) const
     {
         // Trim: when the sample rows this row's edges and cells reach are all above or all below,
         // nothing crosses (most rows of a CT volume).
-        const Word* rows[4];
-        detail::RowSigns signs[4];
-        flags_around(j, k, s, rows, signs);
         const Word *f = rows[0], *fy = rows[1], *fz = rows[2], *fyz = rows[3];
         const bool cells = j + 1 < ny_ && k + 1 < nz_;
         if (s.scan.non_finite) {
@@ -916,14 +937,13 @@ private:
         for (std::int64_t w = 0; w < words_; ++w) {
             const Word x_valid = x_valid_[static_cast<std::size_t>(w)];
             const EdgeWords edges(f, fy, fz, w, x_valid);
-            xy += static_cast<std::uint32_t>(popcount(edges.x) + popcount(edges.y));
-            z += static_cast<std::uint32_t>(popcount(edges.z));
             const Word crossed = cells ? crossed_cells(f, fy, fz, fyz, w, x_valid) : 0;
             const Word used = edges.any() | crossed; // samples whose edges or cells cross
-            if (used != 0) {
-                lo = std::min<std::int64_t>(lo, 64 * w + std::countr_zero(used));
-                hi = 64 * w + 64 - std::countl_zero(used);
-            }
+            if (used == 0) continue;
+            lo = std::min<std::int64_t>(lo, 64 * w + std::countr_zero(used));
+            hi = 64 * w + 64 - std::countl_zero(used);
+            xy += static_cast<std::uint32_t>(popcount(edges.x) + popcount(edges.y));
+            z += static_cast<std::uint32_t>(popcount(edges.z));
             const CellCodes codes(f, fy, fz, fyz, w);
             for (Word bits = crossed; bits != 0; bits &= bits - 1) {
                 const int b = std::countr_zero(bits);
