@@ -415,13 +415,17 @@ public:
         c.rows_.assign(static_cast<std::size_t>((k1 - k0) * ny_), {});
         Scratch s(nx_, ny_);
         for (std::int64_t k = k0; k < k1; ++k) {
-            const Word* rows[4];
-            detail::RowSigns signs[4];
-            flags_around(0, k, s, rows, signs);
-            for (std::int64_t j = 0;;) {
+            const Word* rows[4] = {};
+            detail::RowSigns signs[4] = {};
+            for (std::int64_t j = 0; j < ny_; ++j) {
+                if (j == 0) {
+                    flags_around(j, k, s, rows, signs);
+                } else {
+                    // rows (j, k) and (j, k + 1) are cell row j - 1's upper ones: two lookups, not four
+                    flags_around(j, k, s, rows, signs, rows[1], signs[1], k + 1 < nz_ ? rows[3] : rows[1],
+                                 k + 1 < nz_ ? signs[3] : signs[1]);
+                }
                 count_row(j, k, s, c, rows, signs);
-                if (++j == ny_) break;
-                next_flags_around(j, k, s, rows, signs);
             }
             if (ticker && !ticker->tick()) return c;
         }
@@ -749,27 +753,22 @@ private:
     CMC33_ALWAYS_INLINE void flags_around(std::int64_t j, std::int64_t k, Scratch& s, const Word* (&f)[4],
                                           detail::RowSigns (&signs)[4]) const
     {
-        f[0] = flags(j, k, s, signs[0]);
-        f[1] = f[2] = f[3] = f[0];
-        signs[1] = signs[2] = signs[3] = signs[0];
-        if (j + 1 < ny_) f[1] = flags(j + 1, k, s, signs[1]);
-        if (k + 1 < nz_) f[2] = flags(j, k + 1, s, signs[2]);
-        if (j + 1 < ny_ && k + 1 < nz_) f[3] = flags(j + 1, k + 1, s, signs[3]);
+        detail::RowSigns here_signs{}, above_signs{};
+        const Word* here = flags(j, k, s, here_signs);
+        const Word* above = k + 1 < nz_ ? flags(j, k + 1, s, above_signs) : (above_signs = here_signs, here);
+        flags_around(j, k, s, f, signs, here, here_signs, above, above_signs);
     }
-
-    /// flags_around(j, k) from flags_around(j - 1, k) in `f` and `signs`: rows (j, k) and (j, k + 1)
-    /// are already there (the pass over a plane fetches two rows per cell row, not four).
-    CMC33_ALWAYS_INLINE void next_flags_around(std::int64_t j, std::int64_t k, Scratch& s, const Word* (&f)[4],
-                                               detail::RowSigns (&signs)[4]) const
+    /// ... with rows (j, k) and (j, k + 1) (or (j, k) again past the grid) already looked up: `here`
+    /// and `above`, which may be entries of `f` (they are read before it is written).
+    CMC33_ALWAYS_INLINE void flags_around(std::int64_t j, std::int64_t k, Scratch& s, const Word* (&f)[4],
+                                          detail::RowSigns (&signs)[4], const Word* here, detail::RowSigns here_signs,
+                                          const Word* above, detail::RowSigns above_signs) const
     {
-        const bool up = k + 1 < nz_;
-        const Word* above = up ? f[3] : f[1]; // (j, k + 1), or (j, k) past the grid
-        const detail::RowSigns above_signs = up ? signs[3] : signs[1];
-        f[0] = f[1] = f[3] = f[1];
-        signs[0] = signs[1] = signs[3] = signs[1];
+        f[0] = f[1] = f[3] = here;
+        signs[0] = signs[1] = signs[3] = here_signs;
         f[2] = above, signs[2] = above_signs;
         if (j + 1 < ny_) f[1] = flags(j + 1, k, s, signs[1]);
-        if (j + 1 < ny_ && up) f[3] = flags(j + 1, k + 1, s, signs[3]);
+        if (j + 1 < ny_ && k + 1 < nz_) f[3] = flags(j + 1, k + 1, s, signs[3]);
     }
 
     /// Vertex ids of the edges owned by the samples of row (j, k): ids[3 * i + axis], kNoVertex
