@@ -943,9 +943,11 @@ private:
         // nothing crosses (most rows of a CT volume).
         const Word *f = rows[0], *fy = rows[1], *fz = rows[2], *fyz = rows[3];
         const bool cells = j + 1 < ny_ && k + 1 < nz_;
-        if (s.scan.non_finite) {
-            // before any cell of these rows is decided (a NaN has no sign): name the first one
-            scan_samples(g_, c.k0_, std::min(c.k1_, nz_ - 1));
+        if constexpr (std::is_floating_point_v<T>) {
+            if (s.scan.non_finite) {
+                // before any cell of these rows is decided (a NaN has no sign): name the first one
+                scan_samples(g_, c.k0_, std::min(c.k1_, nz_ - 1));
+            }
         }
         const detail::RowSigns first = signs[0]; // all four rows all above or all below: the counts stay 0
         if (first != detail::RowSigns::mixed && signs[1] == first && signs[2] == first && signs[3] == first) return;
