@@ -17,7 +17,8 @@ namespace detail {
 /// Memory for Buffer: large blocks (1 MiB and more) are rounded up to whole 2 MiB pages, 2 MiB
 /// aligned and marked for transparent huge pages, so that filling a big mesh takes hundreds of
 /// times fewer page faults. Freed blocks of up to 16 MiB (at most four) are kept for the next
-/// allocation of their size.
+/// allocation of their size; blocks from 64 KiB to 1 MiB are rounded up to size classes (at most
+/// 1/8 more) and up to eight are kept alike.
 /// @throws Error{too_large} "cannot allocate N bytes for the mesh (out of memory)"
 CMC33_BASE_EXPORT void* allocate_buffer(std::size_t bytes);
 CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
