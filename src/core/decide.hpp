@@ -450,31 +450,45 @@ inline Decision decide_expansion(const double* raw, double iso, const double* v,
     return d;
 }
 
-/// Decides one cell with `config` not 0 or 255: exactly in 128-bit integers when the samples and
-/// iso are small multiples of a power of two (integer data, and integer-valued floats such as CT
-/// stored as float32: their ties cost what integer data's do); otherwise in filtered double
-/// arithmetic, and where rounding could change a sign, again exactly.
+/// Decides one cell with `config` not 0 or 255: first in filtered double arithmetic without the
+/// eps terms, which settles nearly every cell of data without ties; where a sign is 0 or rounding
+/// could change it, again exactly: in 128-bit integers when the samples and iso are small
+/// multiples of a power of two (integer data, and integer-valued floats such as CT stored as
+/// float32: their ties cost what integer data's do), else in filtered arithmetic with the eps
+/// terms and then in rationals. A corner equal to iso is a 0 sign the filter cannot settle: such
+/// cells of integer data go straight to the integers. (Integer data used to be decided in 128-bit
+/// integers first: stagbeetle 138x138x82 uint16 at 500.5, 20 k decided cells, one thread: count
+/// 2.12 -> 1.59 ms, `cmc33 extract --normals` 5.1 -> 4.5 ms.)
 /// `raw`: the eight corner samples (corner order of cube.hpp). `table`: the method's table set
 /// (tables_of(method)); Decision::variant points into it.
 inline Decision decide(const double* raw, double iso, unsigned config, Method method, const Variant* table = kVariants)
 {
     double v[8];
-    for (int q = 0; q < 8; ++q) v[q] = raw[q] - iso;
+    bool corner_tie = false;
+    for (int q = 0; q < 8; ++q) {
+        v[q] = raw[q] - iso;
+        corner_tie |= v[q] == 0;
+    }
 #if CMC33_HAS_INT128
     // mc33-lewiner's t_alt is a fraction: that method always takes the floating-point path
-    if (method != Method::mc33_lewiner) {
-        if (const double scale = small_integer_scale(raw, iso); scale != 0) {
-            double scaled[8];
-            for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
-            return decide_in<Int128>(scaled, iso * scale, v, config, method, table);
-        }
-    }
+    const double scale = method != Method::mc33_lewiner ? small_integer_scale(raw, iso) : 0;
+#else
+    const double scale = 0;
 #endif
     // first without eps terms (on data without ties no sign is 0), then with them
-    filter_uncertain = false;
-    const Decision quick = decide_in<Filtered, NoEps<Filtered>>(raw, iso, v, config, method, table);
-    if (!filter_uncertain) return quick;
-    filter_uncertain = false;
+    if (scale == 0 || !corner_tie) {
+        filter_uncertain = false;
+        const Decision quick = decide_in<Filtered, NoEps<Filtered>>(raw, iso, v, config, method, table);
+        if (!filter_uncertain) return quick;
+        filter_uncertain = false;
+    }
+#if CMC33_HAS_INT128
+    if (scale != 0) {
+        double scaled[8];
+        for (int q = 0; q < 8; ++q) scaled[q] = raw[q] * scale;
+        return decide_in<Int128>(scaled, iso * scale, v, config, method, table);
+    }
+#endif
     const Decision filtered = decide_in<Filtered>(raw, iso, v, config, method, table);
     if (!filter_uncertain) return filtered;
     filter_uncertain = false;
