@@ -883,12 +883,14 @@ private:
     /// short_count_ and short_offsets_: for the case codes whose fixed tiling has no interior
     /// vertex and at most kShortTiling triangles, where each id of their triangles sits in the
     /// four id rows of IdRows, so that emit_row_cells goes from a cell's code to its ids in two
-    /// loads. (Not for grids so wide that the offsets pass 32 bits.)
+    /// loads. The offsets are 16 bits, a table of 24 KiB that stays in the L1 cache better than
+    /// 32-bit ones did (emit, one thread: nucleon 157 -> 151 us, aneurism about 1 % less); grids
+    /// wider than 7281 samples, where they would not fit, have none (every cell takes emit_cell()).
     void build_short_tilings()
     {
         short_count_.fill(-1);
         const std::int64_t length = 3 * nx_; // IdRows::row_length()
-        if (4 * length > std::numeric_limits<std::int32_t>::max()) return;
+        if (3 * length + 5 > std::numeric_limits<std::uint16_t>::max()) return; // the largest offset
         short_offsets_.assign(4 * 256 * 3 * kShortTiling, 0);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Tiling* tl = fixed_tiling_[code];
@@ -900,7 +902,7 @@ private:
                     // past the tiling the entries stay 0: slot 0's first id, always inside the rows
                     const std::size_t edge = codes[q];
                     short_offsets_[(parity * 256 + code) * 3 * kShortTiling + static_cast<std::size_t>(q)] =
-                        static_cast<std::int32_t>((parity ^ kEdgeRow[edge]) * length + kEdgeSlot[edge]);
+                        static_cast<std::uint16_t>((parity ^ kEdgeRow[edge]) * length + kEdgeSlot[edge]);
                 }
         }
     }
@@ -1294,7 +1296,7 @@ private:
         const bool flip = kOut != Outputs::plain ? mirrored_ != out.reverse_winding : mirrored_;
         // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
         // (none on grids too wide for them: short_count_ is then -1 for every code)
-        const std::int32_t* const short_offsets =
+        const std::uint16_t* const short_offsets =
             short_offsets_.empty() ? nullptr
                                    : short_offsets_.data() + static_cast<std::size_t>((j & 1) | (k & 1) << 1) * 256 * 3 * kShortTiling;
         const std::uint32_t* const id_base = s.ids.base();
@@ -1315,7 +1317,7 @@ private:
                 // most cells: a fixed short tiling, 3 * kShortTiling ids, the ones past the
                 // tiling overwritten by the next cells (no loop whose length the branch
                 // predictor has to guess); copy_end bounds the triangles
-                const std::int32_t* offset = short_offsets + static_cast<std::size_t>(code) * 3 * kShortTiling;
+                const std::uint16_t* offset = short_offsets + static_cast<std::size_t>(code) * 3 * kShortTiling;
                 const std::uint32_t* at = id_base + 3 * i;
                 for (int q = 0; q < 3 * kShortTiling; ++q) o[q] = at[offset[q]];
             } else {
@@ -1466,7 +1468,7 @@ private:
     /// build_short_tilings(): per case code its short tiling's triangle count, or -1; per parity
     /// of the cell row and code, 3 * kShortTiling offsets into IdRows
     std::array<std::int8_t, 256> short_count_{};
-    std::vector<std::int32_t> short_offsets_;
+    std::vector<std::uint16_t> short_offsets_;
 };
 
 namespace {

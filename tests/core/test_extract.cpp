@@ -482,6 +482,20 @@ TEST(Extract, IntegerDataMatchesTheFieldTopologyOnBothExactPaths)
     }
 }
 
+// Rows wider than 7281 samples have no short tilings (their 16-bit offsets would not fit): every
+// cell takes the general path; on both sides of that width the mesh has the field's topology.
+TEST(Extract, GridsTooWideForShortTilingsMatchTheFieldTopology)
+{
+    std::mt19937_64 rng(7281);
+    std::uniform_int_distribution<int> narrow(77, 83);
+    for (const std::int64_t nx : {7281, 7282, 8000}) {
+        Volume u8(cmc33::ScalarType::u8, {nx, 3, 3});
+        for (std::int64_t i = 0; i < u8.sample_count(); ++i) u8.samples<std::uint8_t>()[i] = static_cast<std::uint8_t>(narrow(rng));
+        EXPECT_TRUE(matches_field(u8, 80.5)) << "nx " << nx;
+        EXPECT_TRUE(matches_field(u8, 80.0)) << "nx " << nx << " at 80";
+    }
+}
+
 // Values so small that the verifier's products underflow (1e-100^4): the extractor's exact
 // decisions do not care about scale (same mesh topology as the grid scaled by 2^332), and the
 // verifier must either say "undetermined" or agree, never silently lose an underflowed product.
