@@ -62,6 +62,10 @@ public:
         wake_.notify_all();
         take_tasks(task);
         std::unique_lock lock(mutex_);
+        // Every task has been taken, by this thread or by a worker that joined: the workers not
+        // yet awake are not waited for (a sleeping CPU can take milliseconds to wake on a VM,
+        // longer than the whole job of a small volume); they find the job full when they wake.
+        wanted_ = joined_;
         done_.wait(lock, [this] { return left_ == wanted_; });
         task_ = nullptr;
         return true;
