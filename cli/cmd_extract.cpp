@@ -58,6 +58,7 @@ void run_extract(const ExtractArgs& args)
         runs.push_back(std::chrono::duration<double>(stop - start).count());
     }
     const double seconds = median(runs);
+    if (mesh.triangle_count() == 0) std::cerr << empty_mesh_note(args.input, args.iso, value_range(volume)) << '\n';
     MeshTopology topology;
     MeshGeometry geometry;
     if (!args.no_topology) {

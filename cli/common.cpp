@@ -250,6 +250,18 @@ double pretty(float value)
     return std::strtod(text.c_str(), nullptr);
 }
 
+std::string empty_mesh_note(const std::string& input, double iso, const std::optional<std::pair<double, double>>& range)
+{
+    std::string line = "cmc33: note: " + input + ": the mesh is empty: ";
+    if (range && (iso < range->first || iso > range->second)) {
+        return line + "the isovalue " + num(iso) + " is outside the samples' range [" + num(range->first) + ", " +
+               num(range->second) + "]";
+    }
+    line += "no cell has samples on both sides of the isovalue " + num(iso);
+    if (range) line += " (samples from " + num(range->first) + " to " + num(range->second) + ")";
+    return line + "; a sample equal to the isovalue counts as above it";
+}
+
 std::string sig(double value, int digits)
 {
     char text[64];

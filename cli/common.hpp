@@ -7,6 +7,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -95,6 +96,11 @@ std::string num(float value);
 double pretty(float value);
 /// printf("%.*g"): `digits` significant digits.
 std::string sig(double value, int digits);
+
+/// The note printed on stderr when an extraction gives no triangles (a valid result, exit 0, but
+/// usually an isovalue on the wrong scale): names the input and the isovalue, and where `range`
+/// (the samples' smallest and largest) is known, says whether the isovalue lies outside it.
+std::string empty_mesh_note(const std::string& input, double iso, const std::optional<std::pair<double, double>>& range);
 /// "256x256x256".
 std::string dims_text(const Index3& dims);
 /// "(1, 0.5, 2)".

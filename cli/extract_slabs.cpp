@@ -105,6 +105,7 @@ void run_extract_slabs(const ExtractArgs& args)
         }
         return t;
     });
+    if (totals.triangles == 0) std::cerr << empty_mesh_note(args.input, args.iso, std::nullopt) << '\n';
     const slabs::PlyLayout ply(static_cast<std::uint64_t>(totals.vertices), static_cast<std::uint64_t>(totals.triangles),
                                args.normals);
     std::unique_ptr<FileSink> file;

@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -246,6 +247,39 @@ TEST(Cli, ExtractSummaryLineAndRepeat)
     std::sort(runs.begin(), runs.end());
     EXPECT_DOUBLE_EQ(j["seconds"].get<double>(), runs[1]);
     EXPECT_EQ(j["method"], "mc33-lewiner");
+}
+
+/// A double as the command line prints it (the shortest text that reads back the same)
+std::string num_text(double value)
+{
+    char text[64];
+    return std::string(text, std::to_chars(text, text + sizeof text, value).ptr);
+}
+
+TEST(Cli, ExtractEmptyMeshSaysWhy)
+{
+    // An isovalue on the wrong scale gives an empty mesh: still written and reported (exit 0), with
+    // a note on stderr naming the samples' range, so that it is not mistaken for a flat result.
+    const fs::path dir = test::temp_dir();
+    const std::string sphere = quote(write_sphere(dir).string());
+    const Result out = run("extract " + sphere + " -i 100 --json -o " + quote((dir / "e.ply").string()));
+    ASSERT_EQ(out.code, 0) << out.err;
+    EXPECT_EQ(parse(out)["triangles"].get<std::int64_t>(), 0);
+    EXPECT_TRUE(fs::exists(dir / "e.ply"));
+    const auto [lo, hi] = cmc33::value_range(sphere_volume());
+    EXPECT_NE(out.err.find("cmc33: note: "), std::string::npos) << out.err;
+    EXPECT_NE(out.err.find("the mesh is empty: the isovalue 100 is outside the samples' range [" + num_text(lo) + ", " +
+                           num_text(hi) + "]"),
+              std::string::npos)
+        << out.err;
+    // at the smallest sample every sample counts as above: inside the range, and still empty
+    const Result at_min = run("extract " + sphere + " -i " + num_text(lo));
+    ASSERT_EQ(at_min.code, 0) << at_min.err;
+    EXPECT_NE(at_min.err.find("no cell has samples on both sides of the isovalue " + num_text(lo)), std::string::npos)
+        << at_min.err;
+    const Result full = run("extract " + sphere + " -i " + kIso);
+    ASSERT_EQ(full.code, 0) << full.err;
+    EXPECT_EQ(full.err.find("the mesh is empty"), std::string::npos) << full.err;
 }
 
 TEST(Cli, ExtractNoTopology)

@@ -103,6 +103,12 @@ TEST(CliSlabs, ExtractWritesTheSameFileForEveryFormatMethodAndLimit)
     ASSERT_EQ(a.code, 0);
     ASSERT_EQ(b.code, 0) << b.err;
     EXPECT_EQ(line(a.out), line(b.out));
+    // an empty mesh says so on stderr, slab by slab as in memory (exit 0: it is a valid result)
+    const Result empty = run("extract " + quote(bucky().string()) + " -i 1000 --memory-limit 1M");
+    ASSERT_EQ(empty.code, 0) << empty.err;
+    EXPECT_NE(empty.err.find("the mesh is empty: no cell has samples on both sides of the isovalue 1000"), std::string::npos)
+        << empty.err;
+    EXPECT_EQ(b.err.find("the mesh is empty"), std::string::npos) << b.err;
 }
 
 TEST(CliSlabs, WhatCannotStreamIsAUsageError)
