@@ -643,10 +643,10 @@ TEST(Passes, MisuseIsRefusedBeforeAnyWrite)
 TEST(Passes, PoolRunsEveryTaskOnceAndLeavesNoWorkerInAFinishedJob)
 {
     // The caller of a job does not wait for workers still asleep once every task is taken; a
-    // worker that wakes late must then stay out of that job (its tasks and their data are gone:
-    // each job's counters live on this loop's stack, so ASan and TSan see a late access) and
-    // still join the next ones. Jobs of 2 to 5 tasks back to back, most too short for a worker
-    // to wake in time.
+    // worker that wakes late must then stay out of that job (its task and counters end with the
+    // loop's iteration, so ASan and TSan see a late access; the pool's count of those that left
+    // would never match and the caller would hang) and still join the next ones. Jobs of 2 to 5
+    // tasks back to back, most too short for a worker to wake in time.
     cmc33::detail::ThreadPool& pool = cmc33::detail::ThreadPool::instance();
     int worker_tasks = 0;
     for (int job = 0; job < 3000; ++job) {
