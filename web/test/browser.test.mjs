@@ -42,9 +42,31 @@ async function open(hash, ready = (r) => Boolean(r)) {
 
 const text = (selector) => page.$eval(selector, (e) => e.textContent.trim());
 
+/**
+ * target.screenshot(options) (target: the page or an element), once more if the capture stalls.
+ * Headless chromium's capture can wait on an idle compositor until the protocol times out (seen
+ * once in CI: the first full-page shot of the run, 180 s, where the same test takes under a second
+ * otherwise); that stall says nothing about the page. A screencast started and stopped wakes the
+ * compositor, then the capture is tried once more; a second stall fails the test.
+ */
+async function screenshot(target, options) {
+  try {
+    return await target.screenshot(options);
+  } catch (e) {
+    if (!/timed out/i.test(String(e?.message))) throw e;
+    console.warn(`screenshot ${options.path}: ${e.message}; waking the compositor and trying once more`);
+    const session = await page.createCDPSession();
+    await session.send('Page.startScreencast', { format: 'jpeg', quality: 10 });
+    await new Promise((r) => setTimeout(r, 500));
+    await session.send('Page.stopScreencast');
+    await session.detach();
+    return target.screenshot(options);
+  }
+}
+
 /** Pixel statistics of a screenshot of `selector`, decoded by the browser: share of non-white pixels, colours. */
 async function pixels(selector, file) {
-  const shot = await (await page.$(selector)).screenshot({ path: path.join(SHOTS, file) });
+  const shot = await screenshot(await page.$(selector), { path: path.join(SHOTS, file) });
   return page.evaluate(async (b64) => {
     const bitmap = await createImageBitmap(await (await fetch(`data:image/png;base64,${b64}`)).blob());
     const canvas = new OffscreenCanvas(bitmap.width, bitmap.height);
@@ -66,12 +88,12 @@ test('Appendix A: the link opens 13.5.1 with mc33-lewiner; cmc33 says 13.5.2', a
   await open(`#cell=${cell}&method=mc33-lewiner`, (r) => r?.startsWith('cell '));
   assert.equal(await text('#cell-subcase'), '13.5.1');
   assert.equal(await page.$eval('#cell-method', (e) => e.value), 'mc33-lewiner');
-  await page.screenshot({ path: path.join(SHOTS, 'cell-appendix-a-mc33-lewiner.png'), fullPage: true });
+  await screenshot(page, { path: path.join(SHOTS, 'cell-appendix-a-mc33-lewiner.png'), fullPage: true });
   await page.select('#cell-method', 'cmc33');
   await page.waitForFunction(() => document.querySelector('#cell-subcase')?.textContent === '13.5.2');
   assert.match(page.url(), /method=cmc33/); // the state follows in the fragment
   assert.match(await text('#cell-interior'), /t1 = 0\.635/);
-  await page.screenshot({ path: path.join(SHOTS, 'cell-appendix-a-cmc33.png'), fullPage: true });
+  await screenshot(page, { path: path.join(SHOTS, 'cell-appendix-a-cmc33.png'), fullPage: true });
   const stats = await pixels('#cell-viewer canvas', 'cell-3d.png');
   assert.ok(stats.ink > 0.03 && stats.colours > 20, `3D view not blank: ${JSON.stringify(stats)}`);
 });
@@ -109,7 +131,7 @@ test('neighbouring tunnels: every method, against the field topology', async () 
   assert.match(await text('#tunnels-pair'), /tunnels in both/);
   const stats = await pixels('#tunnels-viewer canvas', 'tunnels-3d.png');
   assert.ok(stats.ink > 0.02, `3D view not blank: ${JSON.stringify(stats)}`);
-  await page.screenshot({ path: path.join(SHOTS, 'tunnels.png'), fullPage: true });
+  await screenshot(page, { path: path.join(SHOTS, 'tunnels.png'), fullPage: true });
 });
 
 async function volumeCounts() {
@@ -138,7 +160,7 @@ test('aneurism at iso 80.5 with cmc33: in under a second, the CLI\'s counts', { 
   assert.ok(ms < 1000, `${ms} ms`);
   assert.deepEqual(await volumeCounts(), cliCounts(cliExtract(ANEURISM, 80.5, 'cmc33')));
   assert.match(await text('#volume-verdict'), /has the topology of the trilinear level set/);
-  await page.screenshot({ path: path.join(SHOTS, 'volume-aneurism.png'), fullPage: true });
+  await screenshot(page, { path: path.join(SHOTS, 'volume-aneurism.png'), fullPage: true });
   const stats = await pixels('#volume-viewer canvas', 'volume-aneurism-3d.png');
   assert.ok(stats.ink > 0.03, `3D view not blank: ${JSON.stringify(stats)}`);
   console.log(`# aneurism 80.5 cmc33 in the page: ${ms} ms`);
@@ -169,7 +191,7 @@ test('the figures plot the sweep data\'s numbers; hover shows them; a click extr
   await page.waitForFunction((iso) => document.querySelector('#figure-hover')?.textContent.includes(`iso ${iso}`), {}, isos[k]);
   const hovered = await page.$$eval('#figure-hover-table tr[data-method]', (trs) => trs.map((tr) => [tr.dataset.method, Number(tr.children[1].textContent), Number(tr.children[4].textContent)]));
   assert.deepEqual(hovered, sweep.methods.map((m) => [m, row(isos[k], m).b0, row(isos[k], m).triangles]));
-  await page.screenshot({ path: path.join(SHOTS, 'figures.png'), fullPage: true });
+  await screenshot(page, { path: path.join(SHOTS, 'figures.png'), fullPage: true });
 
   await page.mouse.click(at.x, at.y);
   await page.waitForFunction(() => document.querySelector('#figures-picked-text'), { timeout: 30000 });

@@ -48,6 +48,9 @@ export async function launch() {
       '--window-size=1400,1100',
     ],
     defaultViewport: { width: 1400, height: 1100 },
+    // a CDP call that has not answered in 90 s has stalled (the longest the tests make, a wait for a
+    // view to be ready, gives up at 60 s); puppeteer's default would wait 180 s
+    protocolTimeout: 90000,
   });
   const close = browser.close.bind(browser);
   browser.close = async () => {
