@@ -143,6 +143,40 @@ template <class T> CMC33_AVX2 inline std::uint64_t above64_int(const T* p, __m25
     return ~below;
 }
 
+/// Samples per 256-bit vector.
+template <class T> constexpr std::int64_t kLanes = 32 / static_cast<std::int64_t>(sizeof(T));
+
+/// The above-bits of the kLanes<T> integer samples at p against t (biased).
+template <class T> CMC33_AVX2 inline std::uint32_t above_lanes_int(const T* p, __m256i t, __m256i b)
+{
+    const __m256i v = load_biased(p, 0, b);
+    if constexpr (sizeof(T) == 1) {
+        return ~static_cast<std::uint32_t>(_mm256_movemask_epi8(_mm256_cmpgt_epi8(t, v)));
+    } else if constexpr (sizeof(T) == 2) {
+        const __m256i below = _mm256_cmpgt_epi16(t, v);
+        const __m128i packed = _mm_packs_epi16(_mm256_castsi256_si128(below), _mm256_extracti128_si256(below, 1));
+        return ~static_cast<std::uint32_t>(_mm_movemask_epi8(packed)) & 0xffffu;
+    } else {
+        const __m256 below = _mm256_castsi256_ps(_mm256_cmpgt_epi32(t, v));
+        return ~static_cast<std::uint32_t>(_mm256_movemask_ps(below)) & 0xffu;
+    }
+}
+
+/// The word of above-bits of row[o, n) (0 < n - o < 64, n >= kLanes<T>) from lanes(p), the bits
+/// of the kLanes<T> samples at p, a vector at a time and none read outside row[0, n): the last
+/// vector ends at the row's end, overlapping the one before, and its bits are shifted into
+/// place. (One sample at a time, a 41-sample row of nucleon 41^3 took 14 % of its extraction.)
+template <class T, class Lanes>
+CMC33_AVX2 inline std::uint64_t above_tail(const T* row, std::int64_t o, std::int64_t n, const Lanes& lanes)
+{
+    std::uint64_t m = 0;
+    for (std::int64_t s = o; s < n; s += kLanes<T>) {
+        const std::int64_t c = std::min(s, n - kLanes<T>);
+        m |= (std::uint64_t{lanes(row + c)} >> (s - c)) << (s - o);
+    }
+    return m;
+}
+
 template <class T>
 CMC33_AVX2 Signs classify_avx2_int(const T* row, std::int64_t n, const Threshold<T>& th, std::uint64_t* bits)
 {
@@ -156,6 +190,12 @@ CMC33_AVX2 Signs classify_avx2_int(const T* row, std::int64_t n, const Threshold
         signs.add(m);
     }
     if (n % 64 == 0) return signs;
+    if (n >= kLanes<T>) {
+        const auto lane_bits = [t, b](const T* p) CMC33_AVX2 { return above_lanes_int<T>(p, t, b); };
+        bits[full] = above_tail<T>(row, 64 * full, n, lane_bits);
+        signs.add(bits[full], (std::uint64_t{1} << (n % 64)) - 1);
+        return signs;
+    }
     RowScan unused;
     return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, unused, signs);
 }
@@ -189,11 +229,24 @@ CMC33_AVX2 Signs classify_avx2_float(const float* row, std::int64_t n, const Thr
         bits[w] = m;
         signs.add(m);
     }
+    const bool tail = n % 64 != 0 && n >= kLanes<float>;
+    if (tail) {
+        const auto lane_bits = [&](const float* p) CMC33_AVX2 {
+            const __m256 v = _mm256_loadu_ps(p);
+            const __m256 a = _mm256_and_ps(v, abs_mask);
+            const __m256 not_finite = _mm256_cmp_ps(a, inf, _CMP_NLT_UQ);
+            bad = _mm256_or_ps(bad, not_finite);
+            largest[0] = _mm256_max_ps(largest[0], _mm256_andnot_ps(not_finite, a));
+            return static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(v, t, _CMP_GE_OQ)));
+        };
+        bits[full] = above_tail(row, 64 * full, n, lane_bits);
+        signs.add(bits[full], (std::uint64_t{1} << (n % 64)) - 1);
+    }
     alignas(32) float lanes[8];
     _mm256_store_ps(lanes, _mm256_max_ps(largest[0], largest[1]));
     for (float x : lanes) scan.largest = std::max(scan.largest, static_cast<double>(x));
     scan.non_finite |= _mm256_movemask_ps(bad) != 0;
-    if (n % 64 == 0) return signs;
+    if (n % 64 == 0 || tail) return signs;
     return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
 }
 
@@ -221,11 +274,24 @@ CMC33_AVX2 Signs classify_avx2_double(const double* row, std::int64_t n, const T
         bits[w] = m;
         signs.add(m);
     }
+    const bool tail = n % 64 != 0 && n >= kLanes<double>;
+    if (tail) {
+        const auto lane_bits = [&](const double* p) CMC33_AVX2 {
+            const __m256d v = _mm256_loadu_pd(p);
+            const __m256d a = _mm256_and_pd(v, abs_mask);
+            const __m256d not_finite = _mm256_cmp_pd(a, inf, _CMP_NLT_UQ);
+            bad = _mm256_or_pd(bad, not_finite);
+            largest[0] = _mm256_max_pd(largest[0], _mm256_andnot_pd(not_finite, a));
+            return static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_cmp_pd(v, t, _CMP_GE_OQ)));
+        };
+        bits[full] = above_tail(row, 64 * full, n, lane_bits);
+        signs.add(bits[full], (std::uint64_t{1} << (n % 64)) - 1);
+    }
     alignas(32) double lanes[4];
     _mm256_store_pd(lanes, _mm256_max_pd(largest[0], largest[1]));
     for (double x : lanes) scan.largest = std::max(scan.largest, x);
     scan.non_finite |= _mm256_movemask_pd(bad) != 0;
-    if (n % 64 == 0) return signs;
+    if (n % 64 == 0 || tail) return signs;
     return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
 }
 

@@ -67,16 +67,19 @@ template <class T> std::vector<double> isovalues()
 template <class T> void check_type()
 {
     std::mt19937_64 rng(7);
-    for (std::size_t n : {1u, 2u, 7u, 31u, 32u, 33u, 63u, 64u, 65u, 127u, 128u, 129u, 200u, 256u, 300u}) {
+    for (std::size_t n : {1u, 2u, 3u, 4u, 5u, 7u, 8u, 9u, 15u, 16u, 17u, 31u, 32u, 33u, 41u, 63u, 64u, 65u, 72u, 95u, 96u,
+                          97u, 127u, 128u, 129u, 200u, 256u, 300u}) {
         const std::vector<T> data = random_row<T>(2 * n, rng);
+        // stride 1: the row alone in an allocation of exactly n samples (ASan sees a read past it)
+        const std::vector<T> alone(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(n));
         for (double iso : isovalues<T>()) {
             const Threshold<T> th(iso);
             for (std::int64_t stride : {1, 2}) {
                 const std::size_t words = (n + 63) / 64;
                 std::vector<std::uint64_t> fast(words + 1, 0xdeadbeef), slow(words + 1, 0xdeadbeef);
                 RowScan fast_scan, slow_scan;
-                const RowSigns fast_signs =
-                    classify_row(data.data(), static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
+                const RowSigns fast_signs = classify_row(stride == 1 ? alone.data() : data.data(),
+                                                         static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
                 const RowSigns slow_signs = classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th,
                                                                   slow.data(), slow_scan);
                 double largest = 0;
@@ -118,7 +121,7 @@ TEST(Classify, EveryTypeMatchesTheSignRule)
 
 template <class T> void check_non_finite()
 {
-    for (std::size_t n : {5u, 64u, 100u}) {
+    for (std::size_t n : {3u, 5u, 9u, 41u, 64u, 100u}) {
         for (std::size_t at : {std::size_t{0}, n / 2, n - 1}) {
             for (T bad : {std::numeric_limits<T>::quiet_NaN(), std::numeric_limits<T>::infinity(),
                           -std::numeric_limits<T>::infinity()}) {
