@@ -170,6 +170,37 @@ TEST(Extract, ReusedMeshBlocksHoldNoTraceOfTheirLastMesh)
     EXPECT_EQ(first.triangles, again.triangles);
 }
 
+TEST(Extract, BlocksPastSixteenMiBAreKeptForTheNextOfTheirSizeClass)
+{
+    // src/base/buffer.cpp: a block of more than 16 MiB is kept when freed and given to the next
+    // request of its size class (the next eighth of its power of two); a request of another
+    // class releases the kept blocks and gets a new one
+    using cmc33::detail::allocate_buffer;
+    using cmc33::detail::deallocate_buffer;
+    constexpr std::size_t kMiB = std::size_t{1} << 20;
+    void* first = allocate_buffer(40 * kMiB);
+    static_cast<char*>(first)[40 * kMiB - 1] = 1;
+    deallocate_buffer(first, 40 * kMiB);
+    void* again = allocate_buffer(37 * kMiB); // the same class (36 to 40 MiB)
+    EXPECT_EQ(again, first);
+    void* other = allocate_buffer(41 * kMiB); // the next class, while `again` is in use
+    EXPECT_NE(other, again);
+    static_cast<char*>(other)[41 * kMiB - 1] = 2;
+    deallocate_buffer(again, 37 * kMiB);
+    deallocate_buffer(other, 41 * kMiB);
+    void* both[2] = {allocate_buffer(38 * kMiB), allocate_buffer(43 * kMiB)};
+    EXPECT_EQ(both[0], first);
+    EXPECT_EQ(both[1], other);
+    deallocate_buffer(both[0], 38 * kMiB);
+    deallocate_buffer(both[1], 43 * kMiB);
+    void* large = allocate_buffer(100 * kMiB); // no class kept: both released, a new block
+    EXPECT_NE(large, nullptr);
+    static_cast<char*>(large)[100 * kMiB - 1] = 3;
+    deallocate_buffer(large, 100 * kMiB);
+    EXPECT_EQ(allocate_buffer(100 * kMiB), large);
+    deallocate_buffer(large, 100 * kMiB);
+}
+
 TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
 {
     // uint8 samples drawn from {60, 80, 100} at iso 80: a third of the samples equal iso.

@@ -18,7 +18,8 @@ namespace detail {
 /// aligned and marked for transparent huge pages, so that filling a big mesh takes hundreds of
 /// times fewer page faults. Freed blocks of up to 16 MiB (at most four) are kept for the next
 /// allocation of their size; blocks from 64 KiB to 1 MiB are rounded up to size classes (at most
-/// 1/8 more) and up to eight are kept alike.
+/// 1/8 more) and up to eight are kept alike. Blocks past 16 MiB are rounded up to size classes
+/// too and up to four are kept, until an allocation past 16 MiB that none fits releases them.
 /// @throws Error{too_large} "cannot allocate N bytes for the mesh (out of memory)"
 CMC33_BASE_EXPORT void* allocate_buffer(std::size_t bytes);
 CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
