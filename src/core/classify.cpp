@@ -200,97 +200,82 @@ CMC33_AVX2 Signs classify_avx2_int(const T* row, std::int64_t n, const Threshold
     return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, unused, signs);
 }
 
-CMC33_AVX2 Signs classify_avx2_float(const float* row, std::int64_t n, const Threshold<float>& th, std::uint64_t* bits,
-                                     RowScan& scan)
+/// The AVX2 operations on a vector of kLanes<T> floating-point samples that classify_avx2_real
+/// needs: the _ps intrinsics for float, the _pd ones for double.
+template <class T> struct RealLanes;
+template <> struct RealLanes<float> {
+    using V = __m256;
+    CMC33_AVX2 static V load(const float* p) { return _mm256_loadu_ps(p); }
+    CMC33_AVX2 static V splat(float x) { return _mm256_set1_ps(x); }
+    CMC33_AVX2 static V abs_mask() { return _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff)); }
+    CMC33_AVX2 static V bit_and(V a, V b) { return _mm256_and_ps(a, b); }
+    CMC33_AVX2 static V and_not(V a, V b) { return _mm256_andnot_ps(a, b); }
+    CMC33_AVX2 static V bit_or(V a, V b) { return _mm256_or_ps(a, b); }
+    CMC33_AVX2 static V max(V a, V b) { return _mm256_max_ps(a, b); }
+    CMC33_AVX2 static V ge(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_GE_OQ); }
+    CMC33_AVX2 static V not_less(V a, V b) { return _mm256_cmp_ps(a, b, _CMP_NLT_UQ); } // true for NaN
+    CMC33_AVX2 static std::uint32_t signs(V v) { return static_cast<std::uint32_t>(_mm256_movemask_ps(v)); }
+    CMC33_AVX2 static void store(float* out, V v) { _mm256_storeu_ps(out, v); }
+};
+template <> struct RealLanes<double> {
+    using V = __m256d;
+    CMC33_AVX2 static V load(const double* p) { return _mm256_loadu_pd(p); }
+    CMC33_AVX2 static V splat(double x) { return _mm256_set1_pd(x); }
+    CMC33_AVX2 static V abs_mask() { return _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff)); }
+    CMC33_AVX2 static V bit_and(V a, V b) { return _mm256_and_pd(a, b); }
+    CMC33_AVX2 static V and_not(V a, V b) { return _mm256_andnot_pd(a, b); }
+    CMC33_AVX2 static V bit_or(V a, V b) { return _mm256_or_pd(a, b); }
+    CMC33_AVX2 static V max(V a, V b) { return _mm256_max_pd(a, b); }
+    CMC33_AVX2 static V ge(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_GE_OQ); }
+    CMC33_AVX2 static V not_less(V a, V b) { return _mm256_cmp_pd(a, b, _CMP_NLT_UQ); }
+    CMC33_AVX2 static std::uint32_t signs(V v) { return static_cast<std::uint32_t>(_mm256_movemask_pd(v)); }
+    CMC33_AVX2 static void store(double* out, V v) { _mm256_storeu_pd(out, v); }
+};
+
+/// classify_row of float or double samples: the flags, and the scan for non-finite samples and
+/// the largest |sample|.
+template <class T>
+CMC33_AVX2 Signs classify_avx2_real(const T* row, std::int64_t n, const Threshold<T>& th, std::uint64_t* bits,
+                                    RowScan& scan)
 {
-    const __m256 t = _mm256_set1_ps(th.value);
-    const __m256 abs_mask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-    const __m256 inf = _mm256_set1_ps(std::numeric_limits<float>::infinity());
-    // the largest |sample| of the finite ones, in two accumulators (even and odd groups of 8) so
-    // that the chain of max_ps is half as long; a non-finite sample counts as 0 (and_not, off the
-    // chain, where a blend was: sphere 256^3 float, one thread, normals, medians of 10 processes
+    using L = RealLanes<T>;
+    using V = typename L::V;
+    const V t = L::splat(th.value), abs_mask = L::abs_mask(), inf = L::splat(std::numeric_limits<T>::infinity());
+    // the largest |sample| of the finite ones, in two accumulators (even and odd vectors) so that
+    // the chain of max is half as long; a non-finite sample counts as 0 (and_not, off the chain,
+    // where a blend was: sphere 256^3 float, one thread, normals, medians of 10 processes
     // alternating, 11.76 -> 11.26 ms and 11.85 -> 11.67 ms; a software prefetch 2 KiB ahead
     // gained nothing more)
-    __m256 largest[2] = {_mm256_setzero_ps(), _mm256_setzero_ps()};
-    __m256 bad = _mm256_setzero_ps();
+    V largest[2] = {L::splat(0), L::splat(0)};
+    V bad = L::splat(0);
+    // the above-bits of the vector at p; its samples join the scan in accumulator `q`
+    const auto lane_bits = [&](const T* p, int q) CMC33_AVX2 {
+        const V v = L::load(p);
+        const V a = L::bit_and(v, abs_mask);
+        const V not_finite = L::not_less(a, inf); // inf or NaN
+        bad = L::bit_or(bad, not_finite);
+        largest[q] = L::max(largest[q], L::and_not(not_finite, a));
+        return L::signs(L::ge(v, t));
+    };
     const std::int64_t full = n / 64;
     Signs signs;
     for (std::int64_t w = 0; w < full; ++w) {
         std::uint64_t m = 0;
-        for (int q = 0; q < 8; ++q) {
-            const __m256 v = _mm256_loadu_ps(row + 64 * w + 8 * q);
-            m |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(v, t, _CMP_GE_OQ))))
-                 << (8 * q);
-            const __m256 a = _mm256_and_ps(v, abs_mask);
-            const __m256 not_finite = _mm256_cmp_ps(a, inf, _CMP_NLT_UQ); // inf or NaN
-            bad = _mm256_or_ps(bad, not_finite);
-            largest[q & 1] = _mm256_max_ps(largest[q & 1], _mm256_andnot_ps(not_finite, a));
+        for (int q = 0; q < 64 / kLanes<T>; ++q) {
+            m |= std::uint64_t{lane_bits(row + 64 * w + kLanes<T> * q, q & 1)} << (kLanes<T> * q);
         }
         bits[w] = m;
         signs.add(m);
     }
-    const bool tail = n % 64 != 0 && n >= kLanes<float>;
+    const bool tail = n % 64 != 0 && n >= kLanes<T>;
     if (tail) {
-        const auto lane_bits = [&](const float* p) CMC33_AVX2 {
-            const __m256 v = _mm256_loadu_ps(p);
-            const __m256 a = _mm256_and_ps(v, abs_mask);
-            const __m256 not_finite = _mm256_cmp_ps(a, inf, _CMP_NLT_UQ);
-            bad = _mm256_or_ps(bad, not_finite);
-            largest[0] = _mm256_max_ps(largest[0], _mm256_andnot_ps(not_finite, a));
-            return static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(v, t, _CMP_GE_OQ)));
-        };
-        bits[full] = above_tail(row, 64 * full, n, lane_bits);
+        bits[full] = above_tail(row, 64 * full, n, [&](const T* p) CMC33_AVX2 { return lane_bits(p, 0); });
         signs.add(bits[full], (std::uint64_t{1} << (n % 64)) - 1);
     }
-    alignas(32) float lanes[8];
-    _mm256_store_ps(lanes, _mm256_max_ps(largest[0], largest[1]));
-    for (float x : lanes) scan.largest = std::max(scan.largest, static_cast<double>(x));
-    scan.non_finite |= _mm256_movemask_ps(bad) != 0;
-    if (n % 64 == 0 || tail) return signs;
-    return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
-}
-
-CMC33_AVX2 Signs classify_avx2_double(const double* row, std::int64_t n, const Threshold<double>& th,
-                                      std::uint64_t* bits, RowScan& scan)
-{
-    const __m256d t = _mm256_set1_pd(th.value);
-    const __m256d abs_mask = _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff));
-    const __m256d inf = _mm256_set1_pd(std::numeric_limits<double>::infinity());
-    __m256d largest[2] = {_mm256_setzero_pd(), _mm256_setzero_pd()}; // as for float
-    __m256d bad = _mm256_setzero_pd();
-    const std::int64_t full = n / 64;
-    Signs signs;
-    for (std::int64_t w = 0; w < full; ++w) {
-        std::uint64_t m = 0;
-        for (int q = 0; q < 16; ++q) {
-            const __m256d v = _mm256_loadu_pd(row + 64 * w + 4 * q);
-            m |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_pd(_mm256_cmp_pd(v, t, _CMP_GE_OQ))))
-                 << (4 * q);
-            const __m256d a = _mm256_and_pd(v, abs_mask);
-            const __m256d not_finite = _mm256_cmp_pd(a, inf, _CMP_NLT_UQ);
-            bad = _mm256_or_pd(bad, not_finite);
-            largest[q & 1] = _mm256_max_pd(largest[q & 1], _mm256_andnot_pd(not_finite, a));
-        }
-        bits[w] = m;
-        signs.add(m);
-    }
-    const bool tail = n % 64 != 0 && n >= kLanes<double>;
-    if (tail) {
-        const auto lane_bits = [&](const double* p) CMC33_AVX2 {
-            const __m256d v = _mm256_loadu_pd(p);
-            const __m256d a = _mm256_and_pd(v, abs_mask);
-            const __m256d not_finite = _mm256_cmp_pd(a, inf, _CMP_NLT_UQ);
-            bad = _mm256_or_pd(bad, not_finite);
-            largest[0] = _mm256_max_pd(largest[0], _mm256_andnot_pd(not_finite, a));
-            return static_cast<std::uint32_t>(_mm256_movemask_pd(_mm256_cmp_pd(v, t, _CMP_GE_OQ)));
-        };
-        bits[full] = above_tail(row, 64 * full, n, lane_bits);
-        signs.add(bits[full], (std::uint64_t{1} << (n % 64)) - 1);
-    }
-    alignas(32) double lanes[4];
-    _mm256_store_pd(lanes, _mm256_max_pd(largest[0], largest[1]));
-    for (double x : lanes) scan.largest = std::max(scan.largest, x);
-    scan.non_finite |= _mm256_movemask_pd(bad) != 0;
+    alignas(32) T lanes[kLanes<T>];
+    L::store(lanes, L::max(largest[0], largest[1]));
+    for (T x : lanes) scan.largest = std::max(scan.largest, static_cast<double>(x));
+    scan.non_finite |= L::signs(bad) != 0;
     if (n % 64 == 0 || tail) return signs;
     return classify_portable(row + 64 * full, n - 64 * full, 1, th, bits + full, scan, signs);
 }
@@ -326,10 +311,8 @@ RowSigns classify_row(const T* row, std::int64_t n, std::int64_t stride, const T
     }
 #if CMC33_CLASSIFY_AVX2
     if (stride == 1 && has_avx2()) {
-        if constexpr (std::is_same_v<T, float>) {
-            return classify_avx2_float(row, n, th, bits, scan).signs();
-        } else if constexpr (std::is_same_v<T, double>) {
-            return classify_avx2_double(row, n, th, bits, scan).signs();
+        if constexpr (std::is_floating_point_v<T>) {
+            return classify_avx2_real(row, n, th, bits, scan).signs();
         } else {
             return classify_avx2_int(row, n, th, bits).signs();
         }
