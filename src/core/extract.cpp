@@ -891,7 +891,9 @@ private:
         short_count_.fill(-1);
         const std::int64_t length = 3 * nx_; // IdRows::row_length()
         // the largest offset: the last of the four id rows (3 = kEdgeRow's largest), the largest slot
-        if (3 * length + *std::ranges::max_element(kEdgeSlot) > std::numeric_limits<std::uint16_t>::max()) return;
+        // (std::max_element: the WebAssembly build's libc++ 13 has no std::ranges::max_element)
+        const std::int64_t largest = 3 * length + *std::max_element(kEdgeSlot.begin(), kEdgeSlot.end());
+        if (largest > std::numeric_limits<std::uint16_t>::max()) return;
         short_offsets_.assign(4 * 256 * 3 * kShortTiling, 0);
         for (unsigned code = 0; code < 256; ++code) {
             const detail::Tiling* tl = fixed_tiling_[code];

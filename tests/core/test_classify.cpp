@@ -67,8 +67,8 @@ template <class T> std::vector<double> isovalues()
 template <class T> void check_type()
 {
     std::mt19937_64 rng(7);
-    for (std::size_t n : {1u, 2u, 3u, 4u, 5u, 7u, 8u, 9u, 15u, 16u, 17u, 31u, 32u, 33u, 41u, 63u, 64u, 65u, 72u, 95u, 96u,
-                          97u, 127u, 128u, 129u, 200u, 256u, 300u}) {
+    for (std::size_t n : {1u, 2u, 3u, 4u, 5u, 7u, 8u, 9u, 15u, 16u, 17u, 31u, 32u, 33u, 41u, 63u, 64u, 65u, 72u,
+                          95u, 96u, 97u, 127u, 128u, 129u, 200u, 256u, 300u}) {
         const std::vector<T> data = random_row<T>(2 * n, rng);
         // stride 1: the row alone in an allocation of exactly n samples (ASan sees a read past it)
         const std::vector<T> alone(data.begin(), data.begin() + static_cast<std::ptrdiff_t>(n));
@@ -78,8 +78,9 @@ template <class T> void check_type()
                 const std::size_t words = (n + 63) / 64;
                 std::vector<std::uint64_t> fast(words + 1, 0xdeadbeef), slow(words + 1, 0xdeadbeef);
                 RowScan fast_scan, slow_scan;
-                const RowSigns fast_signs = classify_row(stride == 1 ? alone.data() : data.data(),
-                                                         static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
+                const T* row = stride == 1 ? alone.data() : data.data();
+                const RowSigns fast_signs =
+                    classify_row(row, static_cast<std::int64_t>(n), stride, th, fast.data(), fast_scan);
                 const RowSigns slow_signs = classify_row_portable(data.data(), static_cast<std::int64_t>(n), stride, th,
                                                                   slow.data(), slow_scan);
                 double largest = 0;
