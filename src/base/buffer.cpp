@@ -73,8 +73,8 @@ public:
         }
         return nullptr;
     }
-    /// A kept block of exactly `bytes`; else none, having released every kept block with
-    /// release(p, bytes).
+    /// A kept block of exactly `bytes`; else none, having released every kept block p with
+    /// release(p).
     template <class Release> void* take_or_release_all(std::size_t bytes, const Release& release) noexcept
     {
         const std::lock_guard lock(mutex_);
@@ -82,7 +82,7 @@ public:
             if (b.p != nullptr && b.bytes == bytes) return std::exchange(b.p, nullptr);
         }
         for (Block& b : blocks_) {
-            if (b.p != nullptr) release(std::exchange(b.p, nullptr), b.bytes);
+            if (b.p != nullptr) release(std::exchange(b.p, nullptr));
         }
         return nullptr;
     }
@@ -120,21 +120,14 @@ std::size_t whole_pages(std::size_t bytes) noexcept
     return whole < bytes ? 0 : whole;
 }
 
-/// The size class of a medium block of `bytes` (kMedium <= bytes < kLarge): rounded up to the
-/// next eighth of its power of two (at most 1/8 more), so that meshes of nearly the same size
-/// (an isovalue sweep) share a class.
-std::size_t medium_class(std::size_t bytes) noexcept
+/// The size class of a medium block of `bytes` (kMedium <= bytes < kLarge) or of one of more
+/// than kHuge bytes: rounded up to the next eighth of its power of two (at most 1/8 more), so
+/// that meshes of nearly the same size (an isovalue sweep) share a class; past kHuge that is
+/// whole huge pages (a step of at least 2 MiB). 0 when that overflows.
+std::size_t size_class(std::size_t bytes) noexcept
 {
     const std::size_t step = std::bit_floor(bytes) / 8;
-    return (bytes + step - 1) / step * step;
-}
-
-/// The size class of a block of more than kHuge bytes: medium_class() (whole huge pages, as its
-/// step is then at least 2 MiB); 0 when that overflows.
-std::size_t huge_class(std::size_t bytes) noexcept
-{
-    const std::size_t step = std::bit_floor(bytes) / 8;
-    return bytes > std::numeric_limits<std::size_t>::max() - (step - 1) ? 0 : medium_class(bytes);
+    return bytes > std::numeric_limits<std::size_t>::max() - (step - 1) ? 0 : (bytes + step - 1) / step * step;
 }
 
 /// A new block of `whole` bytes (whole huge pages, as allocated for a request of `bytes`),
@@ -158,15 +151,15 @@ void* allocate_buffer(std::size_t bytes)
     }
     if (bytes < kLarge) {
         // glibc maps blocks this size afresh (its mmap threshold): every page written faults
-        const std::size_t size = medium_class(bytes);
+        const std::size_t size = size_class(bytes);
         if (void* kept = MediumBlocks::instance().take(size)) return kept;
         void* p = ::operator new(size, std::nothrow);
         if (p == nullptr) out_of_memory(bytes);
         return p;
     }
     if (bytes > kHuge) {
-        const std::size_t size = huge_class(bytes);
-        const auto release = [](void* p, std::size_t) noexcept { aligned_free(p); };
+        const std::size_t size = size_class(bytes);
+        const auto release = [](void* p) noexcept { aligned_free(p); };
         if (void* kept = size == 0 ? nullptr : HugeBlocks::instance().take_or_release_all(size, release)) return kept;
         return huge_page_block(size, bytes);
     }
@@ -181,9 +174,9 @@ void deallocate_buffer(void* p, std::size_t bytes) noexcept
     if (bytes < kMedium) {
         ::operator delete(p);
     } else if (bytes < kLarge) {
-        if (p != nullptr && !MediumBlocks::instance().keep(p, medium_class(bytes))) ::operator delete(p);
+        if (p != nullptr && !MediumBlocks::instance().keep(p, size_class(bytes))) ::operator delete(p);
     } else if (bytes > kHuge) {
-        if (p != nullptr && !HugeBlocks::instance().keep(p, huge_class(bytes))) aligned_free(p);
+        if (p != nullptr && !HugeBlocks::instance().keep(p, size_class(bytes))) aligned_free(p);
     } else if (p != nullptr && !LargeBlocks::instance().keep(p, whole_pages(bytes))) {
         aligned_free(p);
     }

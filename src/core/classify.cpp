@@ -116,16 +116,30 @@ template <class T> CMC33_AVX2 inline __m256i load_biased(const T* p, int q, __m2
     return _mm256_xor_si256(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(p) + q), b);
 }
 
+/// Samples per 256-bit vector.
+template <class T> constexpr std::int64_t kLanes = 32 / static_cast<std::int64_t>(sizeof(T));
+
+/// Bit i: sample i of the kLanes<T> integer samples at p is below t (biased).
+template <class T> CMC33_AVX2 inline std::uint32_t below_lanes_int(const T* p, __m256i t, __m256i b)
+{
+    const __m256i v = load_biased(p, 0, b);
+    if constexpr (sizeof(T) == 1) {
+        return static_cast<std::uint32_t>(_mm256_movemask_epi8(_mm256_cmpgt_epi8(t, v)));
+    } else if constexpr (sizeof(T) == 2) {
+        const __m256i below = _mm256_cmpgt_epi16(t, v);
+        const __m128i packed = _mm_packs_epi16(_mm256_castsi256_si128(below), _mm256_extracti128_si256(below, 1));
+        return static_cast<std::uint32_t>(_mm_movemask_epi8(packed));
+    } else {
+        return static_cast<std::uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(t, v))));
+    }
+}
+
 /// 64 integer samples at p against t (biased): the above-bits.
 template <class T> CMC33_AVX2 inline std::uint64_t above64_int(const T* p, __m256i t, __m256i b)
 {
     std::uint64_t below = 0;
-    if constexpr (sizeof(T) == 1) {
-        for (int q = 0; q < 2; ++q) {
-            const auto m = static_cast<std::uint32_t>(_mm256_movemask_epi8(_mm256_cmpgt_epi8(t, load_biased(p, q, b))));
-            below |= std::uint64_t{m} << (32 * q);
-        }
-    } else if constexpr (sizeof(T) == 2) {
+    if constexpr (sizeof(T) == 2) {
+        // two vectors a movemask, not one each as below_lanes_int does
         for (int q = 0; q < 2; ++q) {
             const __m256i lo = _mm256_cmpgt_epi16(t, load_biased(p, 2 * q, b));
             const __m256i hi = _mm256_cmpgt_epi16(t, load_biased(p, 2 * q + 1, b));
@@ -135,31 +149,17 @@ template <class T> CMC33_AVX2 inline std::uint64_t above64_int(const T* p, __m25
             below |= std::uint64_t{m} << (32 * q);
         }
     } else {
-        for (int q = 0; q < 8; ++q) {
-            const __m256 c = _mm256_castsi256_ps(_mm256_cmpgt_epi32(t, load_biased(p, q, b)));
-            below |= static_cast<std::uint64_t>(static_cast<unsigned>(_mm256_movemask_ps(c))) << (8 * q);
+        for (int q = 0; q < 64 / kLanes<T>; ++q) {
+            below |= std::uint64_t{below_lanes_int(p + kLanes<T> * q, t, b)} << (kLanes<T> * q);
         }
     }
     return ~below;
 }
 
-/// Samples per 256-bit vector.
-template <class T> constexpr std::int64_t kLanes = 32 / static_cast<std::int64_t>(sizeof(T));
-
 /// The above-bits of the kLanes<T> integer samples at p against t (biased).
 template <class T> CMC33_AVX2 inline std::uint32_t above_lanes_int(const T* p, __m256i t, __m256i b)
 {
-    const __m256i v = load_biased(p, 0, b);
-    if constexpr (sizeof(T) == 1) {
-        return ~static_cast<std::uint32_t>(_mm256_movemask_epi8(_mm256_cmpgt_epi8(t, v)));
-    } else if constexpr (sizeof(T) == 2) {
-        const __m256i below = _mm256_cmpgt_epi16(t, v);
-        const __m128i packed = _mm_packs_epi16(_mm256_castsi256_si128(below), _mm256_extracti128_si256(below, 1));
-        return ~static_cast<std::uint32_t>(_mm_movemask_epi8(packed)) & 0xffffu;
-    } else {
-        const __m256 below = _mm256_castsi256_ps(_mm256_cmpgt_epi32(t, v));
-        return ~static_cast<std::uint32_t>(_mm256_movemask_ps(below)) & 0xffu;
-    }
+    return ~below_lanes_int(p, t, b) & static_cast<std::uint32_t>(~std::uint64_t{0} >> (64 - kLanes<T>));
 }
 
 /// The word of above-bits of row[o, n) (0 < n - o < 64, n >= kLanes<T>) from lanes(p), the bits
