@@ -15,11 +15,13 @@
 // rounding (aneurism, `--repeat 5`, one thread, normals: 9.0 ms with the heap, 12.7 ms with fresh
 // huge pages every time on the VM above).
 // Larger blocks (a mesh of about 1.4 M vertices and more) are rounded up to a size class as
-// medium ones are, and up to four are kept too; an allocation that none of them fits releases
-// them all first, so that memory is held only for a next mesh of about the same size and never
-// beside a mesh of another: the peak stays that of one mesh, and what stays mapped after a mesh
-// is freed is at most that mesh's arrays. On this VM memory that another process freed is often
-// handed back to the host, and the first writes to it cost about 2 ms per MiB: sines 512^3
+// medium ones are (those past 64 MiB advised for huge pages only where no VM balloon hands free
+// memory back to the host: advise_huge_blocks below), and up to four are kept too; an allocation
+// that none of them fits releases them all first, so that memory is held only for a next mesh
+// of about the same size and never beside a mesh of another: the peak stays that of one mesh,
+// and what stays mapped after a mesh is freed is at most that mesh's arrays. On this VM memory
+// that another process freed is often handed back to the host, and the first writes to it cost
+// about 2 ms per MiB: sines 512^3
 // (15.5 M triangles, 372 MB of arrays), `cmc33 extract --normals --threads 1 --repeat 5` after
 // a VTK run, three processes: runs 1.15-1.69 s, then 0.33-0.43 s with these blocks kept, where
 // fresh blocks gave one or two more runs of 0.78-1.05 s among 0.36-0.43 s.
@@ -112,6 +114,8 @@ constexpr std::size_t kHuge = std::size_t{16} << 20;
 using LargeBlocks = BlockCache<4, kHuge>;
 using MediumBlocks = BlockCache<8, kLarge>;
 using HugeBlocks = BlockCache<4, std::numeric_limits<std::size_t>::max()>;
+/// Blocks up to this size are advised for huge pages everywhere; larger ones see advise_huge_blocks().
+constexpr std::size_t kAlwaysAdvised = std::size_t{64} << 20;
 
 /// `bytes` rounded up to whole huge pages; 0 when that overflows.
 std::size_t whole_pages(std::size_t bytes) noexcept
@@ -130,14 +134,33 @@ std::size_t size_class(std::size_t bytes) noexcept
     return bytes > std::numeric_limits<std::size_t>::max() - (step - 1) ? 0 : (bytes + step - 1) / step * step;
 }
 
+/// Whether blocks past kAlwaysAdvised are advised for huge pages: not on a VM whose balloon hands
+/// free memory back to its host (balloon_reports_free_memory, read once). There a new huge page
+/// comes from the blocks handed back, and its first writes take a fault in the host per 4 KiB:
+/// on the 2-CPU VM of the README's runs, writing 2 MiB took 4.5-6.0 ms in a huge page against
+/// 0.74-2.0 ms in 4 KiB pages (0.17-0.21 ms in a huge page the process had just freed, of which
+/// there are few). `cmc33 extract --normals --threads 1 --repeat 5` right after a VTK run, builds
+/// alternating: the first extraction, which writes the mesh's blocks for the first time, took
+/// 1125-1363 ms with the advice and 508-706 ms without on sines 512^3 (blocks of 93-186 MB),
+/// 475-571 against 243-324 ms on noise 128^3, 523-608 against 291-366 ms on ties 128^3; the
+/// medians (later extractions reuse the kept blocks) stayed 323-335 against 325, 183-192 against
+/// 183-194, 233-234 against 233-235 ms. Up to 64 MiB the advice stays: mri_head's later
+/// extractions, its 22.5 MB of triangles in 4 KiB pages, were 2.7 % slower (fastest of 14 runs
+/// 38.0-38.4 against 37.0-37.4 ms).
+bool advise_huge_blocks() noexcept
+{
+    static const bool advise = !balloon_reports_free_memory();
+    return advise;
+}
+
 /// A new block of `whole` bytes (whole huge pages, as allocated for a request of `bytes`),
-/// 2 MiB aligned and advised for huge pages.
-void* huge_page_block(std::size_t whole, std::size_t bytes)
+/// 2 MiB aligned, and advised for huge pages when `advise`.
+void* huge_page_block(std::size_t whole, std::size_t bytes, bool advise)
 {
     if (whole == 0) out_of_memory(bytes);
     void* p = aligned_allocate(kHugePageBytes, whole);
     if (p == nullptr) out_of_memory(bytes);
-    advise_huge_pages(p, whole);
+    if (advise) advise_huge_pages(p, whole);
     return p;
 }
 } // namespace
@@ -161,12 +184,12 @@ void* allocate_buffer(std::size_t bytes)
         const std::size_t size = size_class(bytes);
         const auto release = [](void* p) noexcept { aligned_free(p); };
         if (void* kept = size == 0 ? nullptr : HugeBlocks::instance().take_or_release_all(size, release)) return kept;
-        return huge_page_block(size, bytes);
+        return huge_page_block(size, bytes, size <= kAlwaysAdvised || advise_huge_blocks());
     }
     // whole huge pages: the last one's tail, in 4 KiB pages, took a fault per page written
     const std::size_t whole = whole_pages(bytes);
     if (void* kept = whole == 0 ? nullptr : LargeBlocks::instance().take(whole)) return kept;
-    return huge_page_block(whole, bytes);
+    return huge_page_block(whole, bytes, true);
 }
 
 void deallocate_buffer(void* p, std::size_t bytes) noexcept

@@ -8,6 +8,8 @@
 //                               _aligned_malloc on Windows; the advice is a no-op where unknown),
 //                               and the same advice for the whole 2 MiB blocks inside a volume's
 //                               samples before they are first written
+//   balloon_reports_free_memory  whether a VM's balloon hands free memory back to its host, where
+//                               Buffer's largest blocks take no huge pages (src/base/buffer.cpp)
 //   map_readonly / unmap        a read-only file mapping for the mesh readers (mmap); nullptr
 //                               where there is none, and the caller reads the file instead
 //   CMC33_ALWAYS_INLINE         for the extractor's per-row functions, which GCC would otherwise
@@ -25,6 +27,11 @@
 #include <malloc.h>
 #else
 #include <sys/mman.h>
+#endif
+#if defined(__linux__)
+#include <dirent.h>
+#include <fstream>
+#include <string>
 #endif
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -73,6 +80,44 @@ inline void aligned_free(void* p) noexcept
 /// The size of an x86-64 transparent huge page: the unit of advise_huge_pages_within and of
 /// Buffer's large blocks (src/base/buffer.cpp).
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
+
+#if defined(__linux__)
+/// balloon_reports_free_memory() for the virtio devices listed in directory `root` (sysfs).
+inline bool balloon_reports_free_memory_in(const std::string& root)
+{
+    DIR* dir = ::opendir(root.c_str());
+    if (dir == nullptr) return false;
+    bool reports = false;
+    while (const dirent* entry = ::readdir(dir)) {
+        if (entry->d_name[0] == '.') continue;
+        const std::string device = root + entry->d_name;
+        std::string id, features;
+        std::ifstream(device + "/device") >> id;
+        if (id != "0x0005") continue;
+        std::ifstream(device + "/features") >> features; // one '0' or '1' per feature bit
+        reports = reports || (features.size() > 5 && features[5] == '1');
+    }
+    ::closedir(dir);
+    return reports;
+}
+#endif
+
+/// Whether this Linux machine is a VM whose memory balloon reports free memory to its host
+/// (a virtio device of id 5, the balloon, that negotiated feature bit 5, VIRTIO_BALLOON_F_REPORTING):
+/// free blocks of 2 MiB and more that any process gave back are then returned to the host, and
+/// writing one again costs a fault in the host for each of its pages. Reads sysfs; false elsewhere.
+inline bool balloon_reports_free_memory() noexcept
+{
+#if defined(__linux__)
+    try {
+        return balloon_reports_free_memory_in("/sys/bus/virtio/devices/");
+    } catch (...) { // a string that cannot be allocated: no advice either way
+        return false;
+    }
+#else
+    return false;
+#endif
+}
 
 /// Asks for transparent huge pages on [p, p + bytes) (Linux); advice only, failure is harmless.
 inline void advise_huge_pages([[maybe_unused]] void* p, [[maybe_unused]] std::size_t bytes) noexcept

@@ -6,13 +6,19 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
+#include <unistd.h>
 
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
+#include "portability.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -199,6 +205,63 @@ TEST(Extract, BlocksPastSixteenMiBAreKeptForTheNextOfTheirSizeClass)
     deallocate_buffer(large, 100 * kMiB);
     EXPECT_EQ(allocate_buffer(100 * kMiB), large);
     deallocate_buffer(large, 100 * kMiB);
+}
+
+TEST(Extract, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
+{
+    // portability.hpp: a virtio device of id 0x0005 (the balloon) whose features (one '0' or '1'
+    // per bit) have bit 5 (free page reporting) set; in a fake sysfs tree
+    namespace fs = std::filesystem;
+    using cmc33::detail::balloon_reports_free_memory_in;
+    const fs::path root = fs::temp_directory_path() / ("cmc33_sysfs_" + std::to_string(::getpid()));
+    fs::remove_all(root);
+    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/")); // no such directory
+    const auto device = [&](const char* name, const char* id, const char* features) {
+        fs::create_directories(root / name);
+        std::ofstream(root / name / "device") << id << "\n";
+        std::ofstream(root / name / "features") << features << "\n";
+    };
+    device("virtio0", "0x0002", "0110010100000000000000000000000010000000"); // a block device
+    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
+    device("virtio1", "0x0005", "0110000100000000000000000000000010000000"); // a balloon, no reporting
+    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
+    device("virtio1", "0x0005", "01100");
+    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
+    device("virtio1", "0x0005", "0110010100000000000000000000000010000000"); // reporting
+    EXPECT_TRUE(balloon_reports_free_memory_in(root.string() + "/"));
+    fs::remove_all(root);
+}
+
+TEST(Extract, BlocksPastSixtyFourMiBTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
+{
+    // src/base/buffer.cpp: blocks of 1 to 64 MiB are advised for huge pages; larger ones only
+    // where the balloon does not hand free memory back to the host. Seen in /proc/self/smaps
+    // (THPeligible) when the kernel's THP mode is "madvise", where the advice decides.
+    std::string mode;
+    std::getline(std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"), mode);
+    if (mode.find("[madvise]") == std::string::npos) GTEST_SKIP() << "THP mode is not madvise: " << mode;
+    const auto eligible = [](const void* p) {
+        std::ifstream smaps("/proc/self/smaps");
+        const auto at = reinterpret_cast<std::uintptr_t>(p);
+        bool inside = false;
+        for (std::string line; std::getline(smaps, line);) {
+            unsigned long lo = 0, hi = 0;
+            if (std::sscanf(line.c_str(), "%lx-%lx ", &lo, &hi) == 2 && line.find(':') > line.find('-')) {
+                inside = lo <= at && at < hi;
+            } else if (inside && line.rfind("THPeligible:", 0) == 0) {
+                return line.find('1') != std::string::npos;
+            }
+        }
+        ADD_FAILURE() << "no THPeligible line for " << p;
+        return false;
+    };
+    constexpr std::size_t kMiB = std::size_t{1} << 20;
+    void* medium = cmc33::detail::allocate_buffer(48 * kMiB);
+    void* large = cmc33::detail::allocate_buffer(96 * kMiB);
+    EXPECT_TRUE(eligible(medium));
+    EXPECT_EQ(eligible(large), !cmc33::detail::balloon_reports_free_memory());
+    cmc33::detail::deallocate_buffer(medium, 48 * kMiB);
+    cmc33::detail::deallocate_buffer(large, 96 * kMiB);
 }
 
 TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
