@@ -15,7 +15,7 @@
 // rounding (aneurism, `--repeat 5`, one thread, normals: 9.0 ms with the heap, 12.7 ms with fresh
 // huge pages every time on the VM above).
 // Larger blocks (a mesh of about 1.4 M vertices and more) are rounded up to a size class as
-// medium ones are (those past 64 MiB advised for huge pages only where no VM balloon hands free
+// medium ones are (those past 32 MiB advised for huge pages only where no VM balloon hands free
 // memory back to the host: advise_huge_blocks below), and up to four are kept too; an allocation
 // that none of them fits releases them all first, so that memory is held only for a next mesh
 // of about the same size and never beside a mesh of another: the peak stays that of one mesh,
@@ -115,7 +115,7 @@ using LargeBlocks = BlockCache<4, kHuge>;
 using MediumBlocks = BlockCache<8, kLarge>;
 using HugeBlocks = BlockCache<4, std::numeric_limits<std::size_t>::max()>;
 /// Blocks up to this size are advised for huge pages everywhere; larger ones see advise_huge_blocks().
-constexpr std::size_t kAlwaysAdvised = std::size_t{64} << 20;
+constexpr std::size_t kAlwaysAdvised = std::size_t{32} << 20;
 
 /// `bytes` rounded up to whole huge pages; 0 when that overflows.
 std::size_t whole_pages(std::size_t bytes) noexcept
@@ -141,12 +141,15 @@ std::size_t size_class(std::size_t bytes) noexcept
 /// 0.74-2.0 ms in 4 KiB pages (0.17-0.21 ms in a huge page the process had just freed, of which
 /// there are few). `cmc33 extract --normals --threads 1 --repeat 5` right after a VTK run, builds
 /// alternating: the first extraction, which writes the mesh's blocks for the first time, took
-/// 1125-1363 ms with the advice and 508-706 ms without on sines 512^3 (blocks of 93-186 MB),
+/// 1125-1363 ms with the advice and 506-706 ms without on sines 512^3 (blocks of 93-186 MB),
 /// 475-571 against 243-324 ms on noise 128^3, 523-608 against 291-366 ms on ties 128^3; the
 /// medians (later extractions reuse the kept blocks) stayed 323-335 against 325, 183-192 against
-/// 183-194, 233-234 against 233-235 ms. Up to 64 MiB the advice stays: mri_head's later
-/// extractions, its 22.5 MB of triangles in 4 KiB pages, were 2.7 % slower (fastest of 14 runs
-/// 38.0-38.4 against 37.0-37.4 ms).
+/// 183-194, 233-234 against 233-235 ms. Those were blocks past 64 MiB; from 32 MiB (noise's
+/// positions and normals, 47 MB each, too) noise's first extraction took 266-268 ms against
+/// 407-426 with 64, ties-u8's 306-308 against 434-451 (medians alike, 183-185, 220-222 ms). What
+/// 4 KiB pages cost later extractions, where writing the mesh weighs: 1.3 % for a 280^3 sines
+/// field's 53 MB of triangles (fastest of 10 runs 81.4-82.0 against 80.4-80.8 ms), 2.7 % for
+/// mri_head's 22.5 MB (38.0-38.4 against 37.0-37.4 ms): so up to 32 MiB the advice stays.
 bool advise_huge_blocks() noexcept
 {
     static const bool advise = !balloon_reports_free_memory();
