@@ -28,7 +28,7 @@
 #else
 #include <sys/mman.h>
 #endif
-#if defined(__linux__)
+#if !defined(_WIN32)
 #include <dirent.h>
 #include <fstream>
 #include <string>
@@ -81,8 +81,9 @@ inline void aligned_free(void* p) noexcept
 /// Buffer's large blocks (src/base/buffer.cpp).
 inline constexpr std::size_t kHugePageBytes = std::size_t{2} << 20;
 
-#if defined(__linux__)
-/// balloon_reports_free_memory() for the virtio devices listed in directory `root` (sysfs).
+#if !defined(_WIN32)
+/// balloon_reports_free_memory() for the virtio devices listed in directory `root` (Linux's sysfs;
+/// any POSIX system can read such a tree, which the tests make).
 inline bool balloon_reports_free_memory_in(const std::string& root)
 {
     DIR* dir = ::opendir(root.c_str());
