@@ -318,13 +318,16 @@ def tables(records, cases, meta, notes):
                 return r
         return None
 
-    def ms(r):
-        return f"{r['seconds'] * 1e3:.1f}" if r and "seconds" in r else ("failed" if r else "–")
+    def ms(r, key="seconds"):
+        """r[key] in ms; "failed" for a run that gave no time at all."""
+        if r and key in r:
+            return f"{r[key] * 1e3:.1f}"
+        return "failed" if r and "seconds" not in r else "–"
 
-    def ratio(a, b):
-        if not a or not b or "seconds" not in a or "seconds" not in b or b["seconds"] <= 0:
+    def ratio(a, b, key="seconds"):
+        if not a or not b or key not in a or key not in b or b[key] <= 0:
             return "–"
-        return f"{a['seconds'] / b['seconds']:.2f}"
+        return f"{a[key] / b[key]:.2f}"
 
     def mib(r):
         return f"{r['peak_rss_kib'] / 1024:.0f}" if r and r.get("peak_rss_kib") else "–"
@@ -372,14 +375,6 @@ def tables(records, cases, meta, notes):
         a, f = find(c, "cmc33", 1, False), find(c, "vtk-fe", 1, False)
         lines.append(f"| {c} | {ms(a)} | {ms(f)} | {ratio(a, f)} | {mib(a)} / {mib(f)} |")
     if meta["repeat"] > 1:
-        def first(r):
-            return f"{r['first_run_seconds'] * 1e3:.1f}" if r and "first_run_seconds" in r else "–"
-
-        def first_ratio(a, b):
-            if not a or not b or "first_run_seconds" not in a or "first_run_seconds" not in b or b["first_run_seconds"] <= 0:
-                return "–"
-            return f"{a['first_run_seconds'] / b['first_run_seconds']:.2f}"
-
         lines += ["", "## The first extraction in each process (one thread, normals)", "",
                   "What one `cmc33 extract` call, or one Update() of a new VTK pipeline, costs once the volume is "
                   "read: the first extraction of each process (the median over the rounds), from the runs above. "
@@ -387,7 +382,8 @@ def tables(records, cases, meta, notes):
                   "| case | cmc33 1t ms | FE 1t ms | cmc33 / FE | all runs (above) cmc33 / FE ms |", "|---|--:|--:|--:|--:|"]
         for c in cases:
             a, f = find(c, "cmc33", 1), find(c, "vtk-fe", 1)
-            lines.append(f"| {c} | {first(a)} | {first(f)} | {first_ratio(a, f)} | {ms(a)} / {ms(f)} |")
+            first = "first_run_seconds"
+            lines.append(f"| {c} | {ms(a, first)} | {ms(f, first)} | {ratio(a, f, first)} | {ms(a)} / {ms(f)} |")
     lines += ["",
               "FE: vtkFlyingEdges3D. 1t: one thread; all: every core (cmc33 --threads 0, vtkSMPTools' default). "
               "cmc33 / FE below 1 is faster than Flying Edges. speed-up: 1-thread time over all-cores time. "

@@ -157,13 +157,13 @@ bool advise_huge_blocks() noexcept
 }
 
 /// A new block of `whole` bytes (whole huge pages, as allocated for a request of `bytes`),
-/// 2 MiB aligned, and advised for huge pages when `advise`.
-void* huge_page_block(std::size_t whole, std::size_t bytes, bool advise)
+/// 2 MiB aligned, and advised for huge pages up to kAlwaysAdvised, past it as advise_huge_blocks().
+void* huge_page_block(std::size_t whole, std::size_t bytes)
 {
     if (whole == 0) out_of_memory(bytes);
     void* p = aligned_allocate(kHugePageBytes, whole);
     if (p == nullptr) out_of_memory(bytes);
-    if (advise) advise_huge_pages(p, whole);
+    if (whole <= kAlwaysAdvised || advise_huge_blocks()) advise_huge_pages(p, whole);
     return p;
 }
 } // namespace
@@ -187,12 +187,12 @@ void* allocate_buffer(std::size_t bytes)
         const std::size_t size = size_class(bytes);
         const auto release = [](void* p) noexcept { aligned_free(p); };
         if (void* kept = size == 0 ? nullptr : HugeBlocks::instance().take_or_release_all(size, release)) return kept;
-        return huge_page_block(size, bytes, size <= kAlwaysAdvised || advise_huge_blocks());
+        return huge_page_block(size, bytes);
     }
     // whole huge pages: the last one's tail, in 4 KiB pages, took a fault per page written
     const std::size_t whole = whole_pages(bytes);
     if (void* kept = whole == 0 ? nullptr : LargeBlocks::instance().take(whole)) return kept;
-    return huge_page_block(whole, bytes, true);
+    return huge_page_block(whole, bytes);
 }
 
 void deallocate_buffer(void* p, std::size_t bytes) noexcept

@@ -246,7 +246,7 @@ TEST(Extract, BlocksPastThirtyTwoMiBTakeNoHugePagesWhereTheBalloonReportsFreeMem
         bool inside = false;
         for (std::string line; std::getline(smaps, line);) {
             unsigned long lo = 0, hi = 0;
-            if (std::sscanf(line.c_str(), "%lx-%lx ", &lo, &hi) == 2 && line.find(':') > line.find('-')) {
+            if (std::sscanf(line.c_str(), "%lx-%lx ", &lo, &hi) == 2) { // a mapping's header line
                 inside = lo <= at && at < hi;
             } else if (inside && line.rfind("THPeligible:", 0) == 0) {
                 return line.find('1') != std::string::npos;
