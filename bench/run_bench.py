@@ -51,6 +51,30 @@ CASES = {
     "ties": ("work:ties", 80.0, "{60, 80, 100} as float32 at iso 80: ties everywhere, exact decisions"),
     "ties-u8": ("work:ties-u8", 80.0, "the same numbers as uint8"),
 }
+# More real volumes, run only when --cases names them (--cases more: all of these): the rest of
+# ../shared/data/volumes at isovalues from its README, and other surfaces of the default cases'
+# volumes, to check that the default cases' ratios are not theirs alone.
+MORE_CASES = {
+    "tooth": ("tooth_103x94x161_uint8.nrrd", 120.5, "tooth surface, README 110-130"),
+    "headsq-skin": ("headsq_quarter_64x64x93_uint16.nrrd", 500.5, "VTK textbook skin at 500; spacing 3.2 3.2 1.5"),
+    "headsq-bone": ("headsq_quarter_64x64x93_uint16.nrrd", 1150.5, "VTK textbook bone at 1150"),
+    "ironProt": ("ironProt_68x68x68_uint8.nrrd", 96.5, "README 64-128"),
+    "neghip": ("neghip_66x66x66_uint8.nrrd", 90.5, "README 60-130"),
+    "HeadMRVolume": ("HeadMRVolume_48x62x42_uint8.nrrd", 40.5, "head surface about 40; spacing 4 4 4"),
+    "LIDC2-body": ("LIDC2_256x256x133_uint8.nrrd", 60.5, "chest CT body surface about 60 (gzip)"),
+    "LIDC2-bone": ("LIDC2_256x256x133_uint8.nrrd", 150.5, "chest CT bone about 150"),
+    "walnut": ("walnut_128x96x114_uint16.nrrd", 5000.5, "shell and kernel, README 4000-7600"),
+    "Cranium-skin": ("Cranium_256x256x108_int16.nrrd", -400.5, "head CT in Hounsfield units, skin (gzip)"),
+    "Cranium-bone": ("Cranium_256x256x108_int16.nrrd", 400.5, "skull and teeth"),
+    "ch2-head": ("ch2_181x217x181_uint8.nrrd", 30.5, "T1 MRI head surface, README 25-40 (gzip)"),
+    "ch2-brain": ("ch2_181x217x181_uint8.nrrd", 90.5, "white/grey matter boundary, README about 90"),
+    "bonsai-pot": ("bonsai_256x256x256_uint8.nrrd", 150.5, "pot and soil, README 120-200"),
+    "engine-inner": ("engine_256x256x128_uint8.nrrd", 180.5, "dense inner parts, README 170-200"),
+    "mri_head-brain": ("mri_head_256x256x256_uint8.nrrd", 85.5, "brain tissue, README 80-90 (gzip)"),
+    "aneurism-120": ("aneurism_256x256x256_uint8.nrrd", 120.0, "a second integer isovalue"),
+    "CThead-bone": ("CThead_256x256x113_uint16.nrrd", 1500.5, "bone, README 1400-1600"),
+}
+ALL_CASES = {**CASES, **MORE_CASES}
 SIZES = {"sphere": (256, 64), "sines": (512, 128), "noise": (128, 64), "ties": (128, 64), "ties-u8": (128, 64)}  # full, --quick
 TYPE_BYTES = {"int8": 1, "uint8": 1, "int16": 2, "uint16": 2, "int32": 4, "uint32": 4, "float": 4, "double": 8}
 
@@ -96,7 +120,8 @@ def run_tool(cmd, tmp):
 def main(argv):
     p = ArgumentParser(prog=PROG, description=__doc__.split("\n\n")[0])
     p.add_argument("--repeat", type=int, help="extractions per tool and case; the median is reported (default 5; --quick 1)")
-    p.add_argument("--cases", help="comma-separated subset of: " + ",".join(CASES))
+    p.add_argument("--cases", help="comma-separated cases (default: " + ",".join(CASES) + "); also "
+                                   + ",".join(MORE_CASES) + ", or \"more\" for all of those")
     p.add_argument("--quick", action="store_true", help="smoke test: small synthetic volumes, 1 repeat")
     p.add_argument("--out", help="where results.jsonl, results.md and build.log go (default WORK/results)")
     p.add_argument("--volumes", default=os.path.join(REPO, "..", "shared", "data", "volumes"),
@@ -123,9 +148,10 @@ def main(argv):
     if args.pin is not None and shutil.which("taskset") is None:
         p.error("--pin needs taskset (Debian: util-linux)")
     cases = list(CASES) if not args.cases else [c.strip() for c in args.cases.split(",") if c.strip()]
+    cases = [m for c in cases for m in (MORE_CASES if c == "more" else [c])]
     for c in cases:
-        if c not in CASES:
-            p.error(f"unknown case \"{c}\"; expected some of {','.join(CASES)}")
+        if c not in ALL_CASES:
+            p.error(f"unknown case \"{c}\"; expected some of {','.join(ALL_CASES)} or more")
     if not cases:
         p.error("--cases is empty")
     out = args.out or os.path.join(args.work, "results")
@@ -141,7 +167,7 @@ def main(argv):
             die(f"{tool} is missing (scripts/install-deps.sh installs it)")
     files = {}
     for c in cases:
-        f = CASES[c][0]
+        f = ALL_CASES[c][0]
         if f.startswith("work:"):
             kind = f[5:]
             n = SIZES[kind][1 if args.quick else 0]
@@ -179,8 +205,8 @@ def main(argv):
 
     for c in cases:
         f = files[c]
-        if CASES[c][0].startswith("work:") and not (os.path.exists(f) and os.path.getmtime(f) >= os.path.getmtime(make_field)):
-            kind = CASES[c][0][5:]
+        if ALL_CASES[c][0].startswith("work:") and not (os.path.exists(f) and os.path.getmtime(f) >= os.path.getmtime(make_field)):
+            kind = ALL_CASES[c][0][5:]
             n = SIZES[kind][1 if args.quick else 0]
             print(f"{PROG}: making {f}", file=sys.stderr)
             field = ["ties", f, str(n), "--uint8"] if kind == "ties-u8" else [kind, f, str(n)]
@@ -206,7 +232,7 @@ def main(argv):
         total = len(cases) * (args.rounds * len(runs) + 1)
         step = 0
         for c in cases:
-            f, iso = files[c], CASES[c][1]
+            f, iso = files[c], ALL_CASES[c][1]
             info = subprocess.run([cmc33, "info", f, "--json"], capture_output=True, text=True)
             if info.returncode != 0:
                 die(f"case {c}: cmc33 info cannot read {f}: {info.stderr.strip()}")
