@@ -15,8 +15,7 @@
 // rounding (aneurism, `--repeat 5`, one thread, normals: 9.0 ms with the heap, 12.7 ms with fresh
 // huge pages every time on the VM above).
 // Larger blocks (a mesh of about 1.4 M vertices and more) are rounded up to a size class as
-// medium ones are (those past 32 MiB advised for huge pages only where no VM balloon hands free
-// memory back to the host: advise_huge_blocks below), and up to four are kept too; an allocation
+// medium ones are, and up to four are kept too; an allocation
 // that none of them fits releases them all first, so that memory is held only for a next mesh
 // of about the same size and never beside a mesh of another: the peak stays that of one mesh,
 // and what stays mapped after a mesh is freed is at most that mesh's arrays. On this VM memory
@@ -25,6 +24,8 @@
 // (15.5 M triangles, 372 MB of arrays), `cmc33 extract --normals --threads 1 --repeat 5` after
 // a VTK run, three processes: runs 1.15-1.69 s, then 0.33-0.43 s with these blocks kept, where
 // fresh blocks gave one or two more runs of 0.78-1.05 s among 0.36-0.43 s.
+// On such a VM (a balloon that reports free memory: advise_huge_blocks below) no block is advised
+// for huge pages: a new huge page there is the dearest memory to write first.
 // Blocks from 64 KiB to 1 MiB are glibc's too, but above its mmap threshold it maps them afresh
 // for each allocation, a fault per page written: they are rounded up to a size class (the next
 // eighth of their power of two, so that meshes of nearly the same size share one) and up to
@@ -114,9 +115,6 @@ constexpr std::size_t kHuge = std::size_t{16} << 20;
 using LargeBlocks = BlockCache<4, kHuge>;
 using MediumBlocks = BlockCache<8, kLarge>;
 using HugeBlocks = BlockCache<4, std::numeric_limits<std::size_t>::max()>;
-/// Blocks up to this size are advised for huge pages everywhere; larger ones see advise_huge_blocks().
-constexpr std::size_t kAlwaysAdvised = std::size_t{32} << 20;
-
 /// `bytes` rounded up to whole huge pages; 0 when that overflows.
 std::size_t whole_pages(std::size_t bytes) noexcept
 {
@@ -134,22 +132,21 @@ std::size_t size_class(std::size_t bytes) noexcept
     return bytes > std::numeric_limits<std::size_t>::max() - (step - 1) ? 0 : (bytes + step - 1) / step * step;
 }
 
-/// Whether blocks past kAlwaysAdvised are advised for huge pages: not on a VM whose balloon hands
-/// free memory back to its host (balloon_reports_free_memory, read once). There a new huge page
-/// comes from the blocks handed back, and its first writes take a fault in the host per 4 KiB:
-/// on the 2-CPU VM of the README's runs, writing 2 MiB took 4.5-6.0 ms in a huge page against
-/// 0.74-2.0 ms in 4 KiB pages (0.17-0.21 ms in a huge page the process had just freed, of which
-/// there are few). `cmc33 extract --normals --threads 1 --repeat 5` right after a VTK run, builds
-/// alternating: the first extraction, which writes the mesh's blocks for the first time, took
-/// 1125-1363 ms with the advice and 506-706 ms without on sines 512^3 (blocks of 93-186 MB),
-/// 475-571 against 243-324 ms on noise 128^3, 523-608 against 291-366 ms on ties 128^3; the
-/// medians (later extractions reuse the kept blocks) stayed 323-335 against 325, 183-192 against
-/// 183-194, 233-234 against 233-235 ms. Those were blocks past 64 MiB; from 32 MiB (noise's
-/// positions and normals, 47 MB each, too) noise's first extraction took 266-268 ms against
-/// 407-426 with 64, ties-u8's 306-308 against 434-451 (medians alike, 183-185, 220-222 ms). What
-/// 4 KiB pages cost later extractions, where writing the mesh weighs: 1.3 % for a 280^3 sines
-/// field's 53 MB of triangles (fastest of 10 runs 81.4-82.0 against 80.4-80.8 ms), 2.7 % for
-/// mri_head's 22.5 MB (38.0-38.4 against 37.0-37.4 ms): so up to 32 MiB the advice stays.
+/// Whether new blocks are advised for huge pages: not on a VM whose balloon hands free memory back
+/// to its host (balloon_reports_free_memory, read once). There a new huge page comes from the
+/// blocks handed back, and its first writes take a fault in the host per 4 KiB: on the 2-CPU VM
+/// of the README's runs, writing 2 MiB took 4.5-6.0 ms in a huge page against 0.74-2.0 ms in
+/// 4 KiB pages (0.17-0.21 ms in a huge page the process had just freed, of which there are few).
+/// `cmc33 extract --normals --threads 1 --repeat 11|21` (taskset -c 0), builds alternating, the
+/// first extraction (which writes the mesh's blocks for the first time) with the advice against
+/// without it, right after a VTK run: aneurism 13.3-35.9 against 10.6-12.1 ms, CThead at 1500.5
+/// 13.5-49.7 against 18.7-18.8, LIDC2 at 60.5 20.5-65.6 against 28.8-31.9, bonsai 67-91 against
+/// 38-40, sines 512^3 1125-1363 against 506-706, noise 128^3 407-571 against 266-268; in a row
+/// without a VTK run, bonsai 27-117 (mean 59) against 38-58 (mean 43), mri_head 42-160 against
+/// 61-64. Later extractions reuse the kept blocks, and 4 KiB pages cost them
+/// little: medians aneurism 7.43-8.18 against 7.48-7.70 ms, mri_head 37.27-38.76 against
+/// 37.73-38.34, bonsai 23.79-24.22 against 24.33-25.03 (the most: 1.5-2 %, 27 MB of triangles,
+/// positions and normals). First advised only past 64 MiB (25c3f4e), then past 32 MiB.
 bool advise_huge_blocks() noexcept
 {
     static const bool advise = !balloon_reports_free_memory();
@@ -157,13 +154,13 @@ bool advise_huge_blocks() noexcept
 }
 
 /// A new block of `whole` bytes (whole huge pages, as allocated for a request of `bytes`),
-/// 2 MiB aligned, and advised for huge pages up to kAlwaysAdvised, past it as advise_huge_blocks().
+/// 2 MiB aligned, and advised for huge pages where advise_huge_blocks().
 void* huge_page_block(std::size_t whole, std::size_t bytes)
 {
     if (whole == 0) out_of_memory(bytes);
     void* p = aligned_allocate(kHugePageBytes, whole);
     if (p == nullptr) out_of_memory(bytes);
-    if (whole <= kAlwaysAdvised || advise_huge_blocks()) advise_huge_pages(p, whole);
+    if (advise_huge_blocks()) advise_huge_pages(p, whole);
     return p;
 }
 } // namespace

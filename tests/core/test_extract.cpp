@@ -232,11 +232,11 @@ TEST(Extract, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
     fs::remove_all(root);
 }
 
-TEST(Extract, BlocksPastThirtyTwoMiBTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
+TEST(Extract, BlocksTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
 {
-    // src/base/buffer.cpp: blocks of 1 to 32 MiB are advised for huge pages; larger ones only
-    // where the balloon does not hand free memory back to the host. Seen in /proc/self/smaps
-    // (THPeligible) when the kernel's THP mode is "madvise", where the advice decides.
+    // src/base/buffer.cpp: blocks of 1 MiB and more are advised for huge pages, except where the
+    // balloon hands free memory back to the host. Seen in /proc/self/smaps (THPeligible) when the
+    // kernel's THP mode is "madvise", where the advice decides.
     std::string mode;
     std::getline(std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"), mode);
     if (mode.find("[madvise]") == std::string::npos) GTEST_SKIP() << "THP mode is not madvise: " << mode;
@@ -256,12 +256,12 @@ TEST(Extract, BlocksPastThirtyTwoMiBTakeNoHugePagesWhereTheBalloonReportsFreeMem
         return false;
     };
     constexpr std::size_t kMiB = std::size_t{1} << 20;
-    void* medium = cmc33::detail::allocate_buffer(28 * kMiB); // past 16 MiB: the same path as large
-    void* large = cmc33::detail::allocate_buffer(36 * kMiB);
-    EXPECT_TRUE(eligible(medium));
-    EXPECT_EQ(eligible(large), !cmc33::detail::balloon_reports_free_memory());
-    cmc33::detail::deallocate_buffer(medium, 28 * kMiB);
-    cmc33::detail::deallocate_buffer(large, 36 * kMiB);
+    const bool advised = !cmc33::detail::balloon_reports_free_memory();
+    for (const std::size_t bytes : {3 * kMiB, 28 * kMiB, 36 * kMiB}) { // up to 16 MiB, past it, past 32 MiB
+        void* block = cmc33::detail::allocate_buffer(bytes);
+        EXPECT_EQ(eligible(block), advised) << bytes << " bytes";
+        cmc33::detail::deallocate_buffer(block, bytes);
+    }
 }
 
 TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
