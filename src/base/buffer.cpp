@@ -143,10 +143,10 @@ std::size_t size_class(std::size_t bytes) noexcept
 /// 13.5-49.7 against 18.7-18.8, LIDC2 at 60.5 20.5-65.6 against 28.8-31.9, bonsai 67-91 against
 /// 38-40, sines 512^3 1125-1363 against 506-706, noise 128^3 407-571 against 266-268; in a row
 /// without a VTK run, bonsai 27-117 (mean 59) against 38-58 (mean 43), mri_head 42-160 against
-/// 61-64. Later extractions reuse the kept blocks, and 4 KiB pages cost them
-/// little: medians aneurism 7.43-8.18 against 7.48-7.70 ms, mri_head 37.27-38.76 against
-/// 37.73-38.34, bonsai 23.79-24.22 against 24.33-25.03 (the most: 1.5-2 %, 27 MB of triangles,
-/// positions and normals). First advised only past 64 MiB (25c3f4e), then past 32 MiB.
+/// 61-64. Later extractions reuse the kept blocks, and 4 KiB pages cost them little: medians
+/// aneurism 7.43-8.18 against 7.48-7.70 ms, mri_head 37.27-38.76 against 37.73-38.34, bonsai
+/// 23.79-24.22 against 24.33-25.03 (the most: 1.5-2 %, 27 MB of triangles, positions and
+/// normals). Before 2dd20b3 only blocks past 64 MiB (25c3f4e), then past 32 MiB, went unadvised.
 bool advise_huge_blocks() noexcept
 {
     static const bool advise = !balloon_reports_free_memory();
