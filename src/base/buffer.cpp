@@ -15,12 +15,11 @@
 // rounding (aneurism, `--repeat 5`, one thread, normals: 9.0 ms with the heap, 12.7 ms with fresh
 // huge pages every time on the VM above).
 // Larger blocks (a mesh of about 1.4 M vertices and more) are rounded up to a size class as
-// medium ones are, and up to four are kept too; an allocation
-// that none of them fits releases them all first, so that memory is held only for a next mesh
-// of about the same size and never beside a mesh of another: the peak stays that of one mesh,
-// and what stays mapped after a mesh is freed is at most that mesh's arrays. On this VM memory
-// that another process freed is often handed back to the host, and the first writes to it cost
-// about 2 ms per MiB: sines 512^3
+// medium ones are, and up to four are kept too; an allocation that none of them fits releases
+// them all first, so that memory is held only for a next mesh of about the same size and never
+// beside a mesh of another: the peak stays that of one mesh, and what stays mapped after a mesh
+// is freed is at most that mesh's arrays. On this VM memory that another process freed is often
+// handed back to the host, and the first writes to it cost about 2 ms per MiB: sines 512^3
 // (15.5 M triangles, 372 MB of arrays), `cmc33 extract --normals --threads 1 --repeat 5` after
 // a VTK run, three processes: runs 1.15-1.69 s, then 0.33-0.43 s with these blocks kept, where
 // fresh blocks gave one or two more runs of 0.78-1.05 s among 0.36-0.43 s.
@@ -115,6 +114,7 @@ constexpr std::size_t kHuge = std::size_t{16} << 20;
 using LargeBlocks = BlockCache<4, kHuge>;
 using MediumBlocks = BlockCache<8, kLarge>;
 using HugeBlocks = BlockCache<4, std::numeric_limits<std::size_t>::max()>;
+
 /// `bytes` rounded up to whole huge pages; 0 when that overflows.
 std::size_t whole_pages(std::size_t bytes) noexcept
 {

@@ -9,7 +9,7 @@
 //                               and the same advice for the whole 2 MiB blocks inside a volume's
 //                               samples before they are first written
 //   balloon_reports_free_memory  whether a VM's balloon hands free memory back to its host, where
-//                               Buffer's largest blocks take no huge pages (src/base/buffer.cpp)
+//                               Buffer's blocks take no huge pages (src/base/buffer.cpp)
 //   map_readonly / unmap        a read-only file mapping for the mesh readers (mmap); nullptr
 //                               where there is none, and the caller reads the file instead
 //   CMC33_ALWAYS_INLINE         for the extractor's per-row functions, which GCC would otherwise

@@ -13,7 +13,6 @@
 #include <random>
 #include <string>
 #include <vector>
-#include <unistd.h>
 
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
@@ -213,8 +212,7 @@ TEST(Extract, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
     // per bit) have bit 5 (free page reporting) set; in a fake sysfs tree
     namespace fs = std::filesystem;
     using cmc33::detail::balloon_reports_free_memory_in;
-    const fs::path root = fs::temp_directory_path() / ("cmc33_sysfs_" + std::to_string(::getpid()));
-    fs::remove_all(root);
+    const fs::path root = cmc33::test::temp_dir() / "devices";
     EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/")); // no such directory
     const auto device = [&](const char* name, const char* id, const char* features) {
         fs::create_directories(root / name);
@@ -229,7 +227,6 @@ TEST(Extract, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
     EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
     device("virtio1", "0x0005", "0110010100000000000000000000000010000000"); // reporting
     EXPECT_TRUE(balloon_reports_free_memory_in(root.string() + "/"));
-    fs::remove_all(root);
 }
 
 TEST(Extract, BlocksTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
