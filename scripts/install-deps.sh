@@ -47,5 +47,21 @@ echo "install-deps: installing ${missing[*]}" >&2
 sudo=""
 [[ $(id -u) -ne 0 ]] && sudo="sudo"
 export DEBIAN_FRONTEND=noninteractive
-$sudo apt-get update -qq
-$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# Another apt or dpkg (unattended upgrades, a second install) may hold the locks: wait for it as
+# apt itself can (DPkg::Lock::Timeout), up to 10 minutes, instead of failing at once.
+lock_wait=(-o DPkg::Lock::Timeout=600)
+for attempt in $(seq 1 60); do
+    if $sudo apt-get "${lock_wait[@]}" update -qq 2>"${TMPDIR:-/tmp}/install-deps.$$"; then
+        rm -f "${TMPDIR:-/tmp}/install-deps.$$"
+        break
+    fi
+    # apt-get update takes the lists' lock without waiting: retry while another apt holds it
+    if ! grep -qi "lock" "${TMPDIR:-/tmp}/install-deps.$$" || [[ $attempt -eq 60 ]]; then
+        cat "${TMPDIR:-/tmp}/install-deps.$$" >&2
+        rm -f "${TMPDIR:-/tmp}/install-deps.$$"
+        exit 1
+    fi
+    echo "install-deps: waiting for another package manager to release its lock ($attempt)" >&2
+    sleep 10
+done
+$sudo apt-get "${lock_wait[@]}" install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
