@@ -15,6 +15,7 @@
 
 #include <sys/types.h>
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -26,19 +27,42 @@
 
 namespace cmc33::io::detail {
 
-/// Calls write(stream) on a temporary file beside `path`, then renames it to `path`.
-/// If write throws, or the stream fails, the temporary file is removed and Error{io_error}
-/// (or write's own exception) propagates; `path` is left as it was.
-/// The temporary is `.NAME.tmpPID-N` in the target's folder (NAME the target's file name).
+/// What writing `path` replaces. A symbolic link is written through: the bytes go to the file
+/// its links lead to (`target`), and the link stays. An existing target keeps its mode, and its
+/// owner and group where the process may set them (root; a group of its own).
+struct OutputTarget {
+    std::filesystem::path target; ///< `path`, or where its symbolic links lead
+    bool exists = false;          ///< `target` is an existing regular file
+    mode_t mode = 0;              ///< its permission bits (with set-id and sticky bits)
+    uid_t uid = 0;
+    gid_t gid = 0;
+};
+
+/// The OutputTarget of `path`, checked before anything is written. @throws Error{io_error}
+/// naming `path`: a loop of symbolic links, a directory, an existing target that is not a
+/// regular file (a device such as /dev/null is never replaced), or one this process may not
+/// write (read-only: what `>` in a shell refuses is refused too).
+CMC33_IO_EXPORT OutputTarget output_target(const std::filesystem::path& path);
+
+/// Calls write(stream) on a temporary file beside the output_target() of `path`, then renames
+/// it over that target (keeping its mode and owner, see OutputTarget). If write throws, or the
+/// stream fails, the temporary file is removed and Error{io_error} saying why (or write's own
+/// exception) propagates; the target is left as it was.
+/// The temporary is `.NAME.tmpPID-N` in the target's folder (temporary_beside).
 CMC33_IO_EXPORT void write_atomically(const std::filesystem::path& path, const std::function<void(std::ostream&)>& write);
 
 /// The name of a new temporary beside `path`: `.NAME.tmpPID-N` in its folder (checked to be a
-/// folder: Error{io_error} otherwise, or when `path` is a directory).
+/// folder: Error{io_error} otherwise, or when `path` is a directory). NAME is the file name of
+/// `path` cut to kTemporaryNameBytes bytes (at a character boundary), so that the temporary's
+/// name stays short even for a file name of the longest length a folder allows.
 CMC33_IO_EXPORT std::filesystem::path temporary_beside(const std::filesystem::path& path);
+/// The most bytes of the target's name that a temporary's name repeats.
+inline constexpr std::size_t kTemporaryNameBytes = 64;
 
-/// A file written at offsets, in any order (pwrite): a temporary beside `path` (registered, so a
-/// signal removes it), renamed to `path` by commit(). Destroyed before commit(), it is removed
-/// and `path` is left as it was. For writers that know where every byte goes (out-of-core slabs).
+/// A file written at offsets, in any order (pwrite): a temporary beside the output_target() of
+/// `path` (registered, so a signal removes it), renamed over that target by commit(), as
+/// write_atomically() does. Destroyed before commit(), it is removed and the target is left as it
+/// was. For writers that know where every byte goes (out-of-core slabs).
 class CMC33_IO_EXPORT PositionalFile {
 public:
     /// @throws Error{io_error} if the temporary cannot be created
@@ -53,6 +77,7 @@ public:
 
 private:
     std::filesystem::path path_;
+    std::filesystem::path target_;
     int fd_ = -1;
     std::unique_ptr<class Temporary> temp_;
 };

@@ -12,6 +12,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "cmc33/io.hpp"
 #include "atomic_file.hpp"
@@ -306,6 +308,35 @@ Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data, cons
         }
     }
     return read(data, grid, storage, data.label(), nullptr);
+}
+
+std::vector<std::string> metaimage_data_file_names(std::string_view head)
+{
+    std::vector<std::string> names;
+    ByteSource source(head);
+    std::string_view line;
+    bool terminated = false;
+    while (source.next_line(line, terminated)) {
+        const std::size_t equals = line.find('=');
+        if (equals == std::string_view::npos || !equals_ignore_case(trim(line.substr(0, equals)), "ElementDataFile"))
+            continue;
+        const std::string_view value = trim(line.substr(equals + 1));
+        const std::vector<std::string_view> words = split_words(value);
+        if (!words.empty() && equals_ignore_case(words[0], "LIST")) {
+            // File names follow, one a line (MetaIO), or several a line split at blanks.
+            while (source.next_line(line, terminated)) {
+                const std::vector<std::string_view> files = split_words(line);
+                if (files.size() > 1) names.emplace_back(trim(line));
+                for (std::string_view file : files) names.emplace_back(file);
+            }
+        } else if (is_file_pattern(value)) {
+            names = expand_file_pattern(value, kMaxPatternFiles);
+        } else if (!value.empty() && !equals_ignore_case(value, "LOCAL")) {
+            names.emplace_back(value);
+        }
+        break; // ElementDataFile is the header's last line
+    }
+    return names;
 }
 
 void write_metaimage(const Volume& volume, const std::filesystem::path& path, bool local)

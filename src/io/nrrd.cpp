@@ -12,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cmc33/io.hpp"
@@ -70,7 +71,7 @@ constexpr std::string_view kUnsupportedTypes[] = {
 // "axis maxs" are read: kReadFields is looked up first).
 constexpr std::string_view kIgnoredFields[] = {
     "content",     "space",     "space dimension", "space units", "measurement frame",
-    "kinds",       "centers",   "centerings",      "labels",      "units",
+    "centers",     "centerings", "labels",         "units",
     "thicknesses", "axis mins", "axismins",        "axis maxs",   "axismaxs",
     "min",         "max",       "old min",         "oldmin",      "old max",
     "oldmax",      "number",    "sample units",    "sampleunits", "block size",
@@ -100,7 +101,13 @@ constexpr std::pair<std::string_view, std::string_view> kReadFields[] = {
     {"lineskip", "line skip"},
     {"data file", "data file"},
     {"datafile", "data file"},
+    {"kinds", "kinds"},
 };
+
+// The kinds of an axis along which samples are places (teem's domain kinds; "???" and "none" say
+// nothing). Every other kind (RGB-color, 3-vector, list, complex, ...) makes an axis of values
+// per sample: meshing across it would mix channels as if they were neighbours in space.
+constexpr std::string_view kDomainKinds[] = {"domain", "space", "time", "???", "none"};
 
 struct Field {
     std::string value;
@@ -298,6 +305,36 @@ std::int64_t parse_skip(const Field& field, std::string_view name, std::int64_t 
     return n;
 }
 
+/// "kinds": Error{unsupported_format} for an axis that is not a domain axis (channels), naming it;
+/// Error{bad_format} when the kinds are not one per axis.
+void check_kinds(const Field& kinds, std::int64_t dimension, const Field* sizes, const std::string& label)
+{
+    const std::vector<std::string_view> words = split_words(kinds.value);
+    const std::vector<std::string_view> size_words =
+        sizes ? split_words(sizes->value) : std::vector<std::string_view>{};
+    for (std::size_t axis = 0; axis < words.size(); ++axis) {
+        bool domain = false;
+        for (std::string_view k : kDomainKinds) domain = domain || equals_ignore_case(k, words[axis]);
+        if (domain) continue;
+        std::int64_t count = 0;
+        const std::string size = axis < size_words.size() && parse_integer(size_words[axis], count)
+                                     ? str_cat(" (size ", count, ")")
+                                     : std::string();
+        throw Error(Status::unsupported_format,
+                    str_cat(label, ": kinds ", quote_bytes(kinds.value, 80), " (line ", kinds.line, "): axis ",
+                            axis, size, " is ", quote_bytes(words[axis]),
+                            ", values per sample, not a spatial axis; cmc33 meshes one scalar per sample "
+                            "over 3 spatial axes (kinds domain or space): extract one channel first "
+                            "(unu slice -a ",
+                            axis, " -p 0)"));
+    }
+    if (words.size() != static_cast<std::size_t>(dimension) && dimension == 3) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": field \"kinds\" (line ", kinds.line, ") ", quote_bytes(kinds.value),
+                            " has ", words.size(), " kinds, expected 3 (one per axis)"));
+    }
+}
+
 /// The offset after `lines` more line ends, counted from `offset`.
 std::uint64_t skip_lines(const ByteInput& file, std::uint64_t offset, std::int64_t lines,
                          const std::string& label)
@@ -404,7 +441,7 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
                                                     "\"sizes\" or \"space origin\")"));
         }
         const std::string_view value = trim(line.substr(colon + 1));
-        if (name == "data file" && (value == "LIST" || value.substr(0, 5) == "LIST ")) {
+        if (name == "data file" && !split_words(value).empty() && split_words(value)[0] == "LIST") {
             // The file names follow on the next lines, which are not fields: stop here.
             throw Error(Status::unsupported_format,
                         str_cat(label, ": \"data file: LIST\" (line ", line_number,
@@ -443,6 +480,7 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
         throw Error(Status::bad_format, str_cat(label, ": dimension ", quote_bytes(dimension.value),
                                                 " (line ", dimension.line, ") is not an integer"));
     }
+    if (const Field* kinds = find(fields, "kinds")) check_kinds(*kinds, dim, find(fields, "sizes"), label);
     if (dim != 3) {
         throw Error(Status::unsupported_format,
                     str_cat(label, ": dimension ", dim, " (line ", dimension.line,
@@ -553,6 +591,38 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
         }
     }
     return read(data, grid, storage, data_label, nullptr);
+}
+
+std::vector<std::string> nrrd_data_file_names(std::string_view head)
+{
+    std::vector<std::string> names;
+    ByteSource source(head);
+    std::string_view line;
+    bool terminated = false;
+    source.next_line(line, terminated); // the magic
+    while (source.next_line(line, terminated)) {
+        if (trim(line).empty()) break; // the end of the header
+        const std::size_t colon = line.find(':');
+        if (colon == std::string_view::npos || (colon + 1 < line.size() && line[colon + 1] == '=')) continue;
+        const std::string name = normalize_blanks(line.substr(0, colon));
+        if (name != "data file" && name != "datafile") continue;
+        const std::string_view value = trim(line.substr(colon + 1));
+        const std::vector<std::string_view> words = split_words(value);
+        if (!words.empty() && words[0] == "LIST") {
+            // Every later line names one file, to the end of the header file.
+            while (source.next_line(line, terminated)) {
+                if (!trim(line).empty()) names.emplace_back(trim(line));
+            }
+            break;
+        }
+        if (is_file_pattern(value)) {
+            const std::vector<std::string> expanded = expand_file_pattern(value, kMaxPatternFiles);
+            names.insert(names.end(), expanded.begin(), expanded.end());
+        } else if (!value.empty()) {
+            names.emplace_back(value);
+        }
+    }
+    return names;
 }
 
 void write_nrrd(const Volume& volume, const std::filesystem::path& path, bool detached)

@@ -91,6 +91,19 @@ std::string read_header_bytes(const ByteInput& file, std::string_view format);
 std::filesystem::path resolve_data_file(const std::filesystem::path& header, std::string_view name);
 /// True for the multi-file form "<printf pattern> <min> <max> <step> [<axis>]" (NRRD, MetaImage).
 bool is_file_pattern(std::string_view value);
+/// The names a multi-file form stands for (at most `max_names`, the first ones), formatted as
+/// printf would with an int. Empty unless the pattern has exactly one integer conversion (%d, %i,
+/// %u with flags, width, precision; "%%" is a '%') and min, max fit an int.
+std::vector<std::string> expand_file_pattern(std::string_view value, std::size_t max_names);
+/// The most names volume_files() lists for one multi-file pattern.
+constexpr std::size_t kMaxPatternFiles = std::size_t{1} << 16;
+
+/// The data files a NRRD (or MetaImage) header names, as written: a single name, the lines after
+/// "data file: LIST" (ElementDataFile = LIST), or a pattern's names. Read leniently from the start
+/// of the header file, without the reader's checks, so that even a header the reader refuses
+/// shows what it points to. Empty for an attached header (ElementDataFile = LOCAL).
+std::vector<std::string> nrrd_data_file_names(std::string_view head);
+std::vector<std::string> metaimage_data_file_names(std::string_view head);
 
 // ---- samples --------------------------------------------------------------------------------
 

@@ -9,7 +9,10 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
+#include <string>
 #include <type_traits>
+#include <vector>
 
 #include "cmc33/io.hpp"
 #include "atomic_file.hpp"
@@ -332,6 +335,96 @@ bool is_file_pattern(std::string_view value)
     return true;
 }
 
+namespace {
+
+/// One printf integer conversion ("%05d" and the like), as parsed from a file pattern.
+struct Conversion {
+    bool left = false, zero = false, plus = false, space = false, is_unsigned = false;
+    int width = 0;
+    int precision = -1;
+};
+
+std::string format_int(int value, const Conversion& c)
+{
+    const bool negative = value < 0 && !c.is_unsigned;
+    const std::uint64_t magnitude =
+        c.is_unsigned ? static_cast<unsigned>(value)
+                      : (negative ? std::uint64_t{0} - static_cast<std::uint64_t>(static_cast<std::int64_t>(value))
+                                  : static_cast<std::uint64_t>(value));
+    std::string digits = c.precision == 0 && magnitude == 0 ? std::string() : std::to_string(magnitude);
+    if (c.precision > 0 && digits.size() < static_cast<std::size_t>(c.precision))
+        digits.insert(0, static_cast<std::size_t>(c.precision) - digits.size(), '0');
+    const std::string sign = negative ? "-" : c.is_unsigned ? "" : c.plus ? "+" : c.space ? " " : "";
+    const std::size_t length = sign.size() + digits.size();
+    const std::size_t pad = static_cast<std::size_t>(c.width) > length ? static_cast<std::size_t>(c.width) - length : 0;
+    if (c.left) return sign + digits + std::string(pad, ' ');
+    if (c.zero && c.precision < 0) return sign + std::string(pad, '0') + digits;
+    return std::string(pad, ' ') + sign + digits;
+}
+
+} // namespace
+
+std::vector<std::string> expand_file_pattern(std::string_view value, std::size_t max_names)
+{
+    const std::vector<std::string_view> words = split_words(value);
+    std::int64_t first = 0, last = 0, step = 0;
+    if (!is_file_pattern(value) || !parse_integer(words[1], first) || !parse_integer(words[2], last) ||
+        !parse_integer(words[3], step) || step == 0) {
+        return {};
+    }
+    constexpr std::int64_t kIntMin = std::numeric_limits<int>::min(), kIntMax = std::numeric_limits<int>::max();
+    if (first < kIntMin || first > kIntMax || last < kIntMin || last > kIntMax) return {};
+    // The format: literal text around exactly one integer conversion.
+    const std::string_view format = words[0];
+    std::string before, after;
+    std::optional<Conversion> conversion;
+    for (std::size_t i = 0; i < format.size(); ++i) {
+        std::string& text = conversion ? after : before;
+        if (format[i] != '%') {
+            text += format[i];
+            continue;
+        }
+        if (i + 1 < format.size() && format[i + 1] == '%') {
+            text += '%';
+            ++i;
+            continue;
+        }
+        if (conversion) return {}; // a second conversion: not a pattern of one number
+        Conversion c;
+        std::size_t j = i + 1;
+        for (; j < format.size() && std::string_view("-0+ ").find(format[j]) != std::string_view::npos; ++j) {
+            c.left = c.left || format[j] == '-';
+            c.zero = c.zero || format[j] == '0';
+            c.plus = c.plus || format[j] == '+';
+            c.space = c.space || format[j] == ' ';
+        }
+        const auto number = [&](int& out) {
+            const std::size_t start = j;
+            while (j < format.size() && j - start < 4 && std::isdigit(static_cast<unsigned char>(format[j]))) {
+                out = out * 10 + (format[j] - '0');
+                ++j;
+            }
+        };
+        number(c.width);
+        if (j < format.size() && format[j] == '.') {
+            ++j;
+            c.precision = 0;
+            number(c.precision);
+        }
+        if (j >= format.size() || std::string_view("diu").find(format[j]) == std::string_view::npos) return {};
+        c.is_unsigned = format[j] == 'u';
+        conversion = c;
+        i = j;
+    }
+    if (!conversion) return {};
+    std::vector<std::string> names;
+    for (std::int64_t n = first; (step > 0 ? n <= last : n >= last) && names.size() < max_names; n += step) {
+        names.push_back(before + format_int(static_cast<int>(n), *conversion) + after);
+        if (step > 0 ? n > kIntMax - step : n < kIntMin - step) break; // the next one is past any int
+    }
+    return names;
+}
+
 // ---- samples --------------------------------------------------------------------------------
 
 namespace {
@@ -635,6 +728,25 @@ bool has_volume_header(const std::filesystem::path& path)
 {
     const std::string ext = detail::lower_extension(path);
     return ext == ".nrrd" || ext == ".nhdr" || ext == ".mhd" || ext == ".mha" || ext == ".vtk";
+}
+
+std::vector<std::filesystem::path> volume_files(const std::filesystem::path& path)
+{
+    std::vector<std::filesystem::path> files{path};
+    const std::string ext = detail::lower_extension(path);
+    const bool nrrd = ext == ".nrrd" || ext == ".nhdr";
+    if (!nrrd && ext != ".mhd" && ext != ".mha") return files; // VTK and raw files hold their samples
+    std::string head;
+    try {
+        const detail::InputFile file(path, path.string());
+        head = file.read_string(0, detail::kMaxHeaderBytes);
+    } catch (const Error&) {
+        return files; // read_volume() fails on this file before it opens any other
+    }
+    const std::vector<std::string> names =
+        nrrd ? detail::nrrd_data_file_names(head) : detail::metaimage_data_file_names(head);
+    for (const std::string& name : names) files.push_back(detail::resolve_data_file(path, name));
+    return files;
 }
 
 Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw)

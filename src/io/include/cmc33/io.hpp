@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
@@ -100,5 +101,13 @@ CMC33_IO_EXPORT Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat fo
 
 /// True for names whose extension read_volume() knows without RawOptions.
 CMC33_IO_EXPORT bool has_volume_header(const std::filesystem::path& path);
+
+/// Every file that reading the volume `path` may open, found without reading samples: `path`,
+/// then the data files its header names (NRRD "data file:", MetaImage ElementDataFile; a single
+/// name, a LIST, or a numbered pattern's first 65536 names), relative to the header's folder as
+/// read_volume() resolves them. Lists the forms read_volume() refuses too: for the rule that a
+/// command never writes over a file it reads. Only `path` when its header cannot be read or names
+/// no other file. Never throws Error.
+CMC33_IO_EXPORT std::vector<std::filesystem::path> volume_files(const std::filesystem::path& path);
 
 } // namespace cmc33::io
