@@ -2,7 +2,8 @@
 # Builds the executable paper into build/web/: the library compiled to WebAssembly by Debian's
 # emscripten (CMake, build/wasm; web/CMakeLists.txt), the page bundled by esbuild from web/ with
 # the npm packages of web/package-lock.json, the bundled volumes (data/, and ../shared/data/volumes
-# when that folder is beside the clone) and the sweep data of docs/figures/*.json.
+# when that folder is beside the clone) and the sweep data files of docs/figures/*.json that the
+# page opens (web/tools/index.mjs picks them).
 # Installs what is missing first (scripts/install-deps.sh --web, npm ci). Serve the folder with
 # any static file server, e.g.  python3 -m http.server -d build/web 8033  and open
 # http://localhost:8033/
@@ -35,9 +36,6 @@ cp data/*.nrrd "$out/volumes/"
 if [[ -d ../shared/data/volumes ]]; then
     cp ../shared/data/volumes/*.nrrd "$out/volumes/"
 fi
-shopt -s nullglob
-for f in docs/figures/*.json; do
-    cp "$f" "$out/figures/"
-done
-node --no-experimental-fetch web/tools/index.mjs "$out"
+# the sweep data files of docs/figures/ that the page opens (index.mjs copies those and lists them)
+node --no-experimental-fetch web/tools/index.mjs "$out" docs/figures
 echo "build-web: done; serve it with: python3 -m http.server -d $out 8033" >&2

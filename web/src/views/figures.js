@@ -1,9 +1,11 @@
 // The real-data figures (Figs. 13 and 14) from a sweep data file (docs/figures/*.json, written by
 // `cmc33 sweep`; its shape: {volume, dims, type, cells, methods, rows: [{iso, method, vertices,
-// triangles, euler, b0, b1, b2, boundary_loops, non_manifold_edges, expected}]}). Hovering shows an
-// isovalue's counts; clicking one extracts that mesh here, in the page.
+// triangles, euler, b0, b1, b2, boundary_loops, non_manifold_edges, expected}]}), or a file of
+// several such sweeps ({volumes: [{sweep, ...}]}, as scripts/paper/fig14_nonmanifold.py writes).
+// Hovering shows an isovalue's counts; clicking one extracts that mesh here, in the page.
 import { el } from '../state.js';
 import { linePlot, color } from '../plots.js';
+import { sweepsOf } from '../sweeps.js';
 import { Viewer, surface } from '../viewer.js';
 import { takeMesh } from '../cmc33.js';
 
@@ -26,34 +28,39 @@ export function seriesOf(sweep) {
   return { isos, methods, byMethod };
 }
 
-export function figuresView(root, cmc33, state, setState) {
+export function figuresView(root, cmc33, state, setState, report = () => {}) {
   let file = state.data ?? '';
+  let part = state.part ?? '';
   let method = state.method ?? 'cmc33';
   let pick = Number(state.pick);
-  let sweep = null, volume = null, volumeName = '';
+  let sweep = null, sweeps = [], volume = null, volumeName = '';
   const plots = [];
 
   const claim13 = el('p', { class: 'claim' },
-    'Fig. 13 of the paper: the number of connected components each method finds minus the number C-MC33 finds, ' +
-    'as the isovalue sweeps the aneurysm. VTK (classic Marching Cubes) finds up to 2400 more; MC33 a few more for most ' +
-    'isovalues. Here each method of the library is one curve, b0(method) − b0(cmc33), from the sweep data file.');
+    'Fig. 13 of the paper: the number of connected components a method finds minus the number C-MC33 finds, ' +
+    'as the isovalue sweeps the aneurysm; left VTK (classic Marching Cubes), which finds up to 2400 more, right MC33, ' +
+    'a few more for most isovalues. Here the library\'s classic Marching Cubes (mc) on the left and its MC33 ' +
+    'methods on the right, each b0(method) − b0(cmc33), from the sweep data file; each plot has its own scale.');
   const claim14 = el('p', { class: 'claim' },
     'Fig. 14: MC33\'s triangulation table leaves non-manifold edges where two neighbouring tunnels share a face ' +
     '("one case per 10⁷ voxels"). Here, the non-manifold edges of each method\'s mesh at each isovalue.');
   const select = el('select', { id: 'figures-select' }, el('option', { value: '' }, 'sweep data…'));
+  const partSelect = el('select', { id: 'figures-part', hidden: true });
   const about = el('div', { id: 'figures-about' });
-  const hover = el('div', { id: 'figure-hover' }, 'hover over a plot to see an isovalue\'s counts; click to extract that mesh');
-  const fig13 = el('div', { id: 'fig13' }), fig14 = el('div', { id: 'fig14' });
+  const hover = el('div', { id: 'figure-hover' });
+  const fig13vtk = el('div', { id: 'fig13-vtk' }), fig13mc33 = el('div', { id: 'fig13-mc33' }), fig14 = el('div', { id: 'fig14' });
   const error = el('div', { class: 'error', id: 'figures-error' });
   const methodSelect = el('select', { id: 'figures-method' });
   const picked = el('div', { id: 'figures-picked' });
   const viewerBox = el('div', { class: 'viewer', id: 'figures-viewer', style: 'width:640px;height:420px' });
   root.append(
     el('h2', {}, 'Real data'),
-    el('div', { class: 'panel' }, select, about, error),
-    el('div', { class: 'row' }, el('div', { class: 'panel' }, el('h3', {}, 'Fig. 13: extra components'), claim13, fig13),
-      el('div', { class: 'panel' }, el('h3', {}, 'Fig. 14: non-manifold edges'), claim14, fig14)),
-    el('div', { class: 'panel' }, hover),
+    el('div', { class: 'panel' }, select, ' ', partSelect, about, error),
+    el('div', { class: 'panel' }, el('h3', {}, 'Fig. 13: extra components'), claim13,
+      el('div', { class: 'row' }, el('div', {}, el('h4', {}, 'classic Marching Cubes (VTK\'s algorithm: mc) − cmc33'), fig13vtk),
+        el('div', {}, el('h4', {}, 'MC33 − cmc33'), fig13mc33))),
+    el('div', { class: 'row' }, el('div', { class: 'panel' }, el('h3', {}, 'Fig. 14: non-manifold edges'), claim14, fig14),
+      el('div', { class: 'panel' }, hover)),
     el('div', { class: 'row' }, el('div', { class: 'panel' }, el('label', {}, 'method ', methodSelect), picked), viewerBox),
   );
   const viewer = new Viewer(viewerBox, { width: 640, height: 420 });
@@ -61,11 +68,11 @@ export function figuresView(root, cmc33, state, setState) {
   methodSelect.value = cmc33.methods().includes(method) ? method : 'cmc33';
   methodSelect.addEventListener('change', () => {
     method = methodSelect.value;
-    if (Number.isFinite(pick)) extractAt(pick);
+    if (Number.isFinite(pick) && sweep) extractAt(pick);
   });
 
   dataFiles().then((list) => {
-    for (const f of list) select.append(el('option', { value: f.file }, `${f.volume} (${f.rows} rows)`));
+    for (const f of list) select.append(el('option', { value: f.file }, f.label ?? `${f.volume} (${f.rows} rows)`));
     if (!file && list.length) file = list[0].file;
     if (file && !list.some((f) => f.file === file)) select.append(el('option', { value: file }, file));
     if (file) {
@@ -79,37 +86,82 @@ export function figuresView(root, cmc33, state, setState) {
   select.addEventListener('change', () => {
     if (!select.value) return;
     file = select.value;
+    part = '';
     pick = NaN;
     load(file);
   });
+  partSelect.addEventListener('change', () => {
+    part = partSelect.value;
+    pick = NaN;
+    choose();
+  });
 
   function save() {
-    setState({ view: 'figures', data: file, pick: Number.isFinite(pick) ? pick : undefined, method });
+    setState({ view: 'figures', data: file, part: sweeps.length > 1 ? part : undefined, pick: Number.isFinite(pick) ? pick : undefined, method });
+  }
+
+  /** Forgets the shown sweep: its description, plots, counts and mesh (before a load, or when one fails). */
+  function clear() {
+    for (const p of plots.splice(0)) p.destroy();
+    sweep = null;
+    volume?.delete();
+    volume = null;
+    about.textContent = '';
+    error.textContent = '';
+    for (const box of [fig13vtk, fig13mc33, fig14]) box.replaceChildren();
+    hover.textContent = 'hover over a plot to see an isovalue\'s counts; click to extract that mesh';
+    picked.replaceChildren();
+    viewer.show([]);
+    window.cmc33Page.figures = null;
   }
 
   async function load(url) {
-    error.textContent = '';
+    clear();
+    sweeps = [];
+    partSelect.hidden = true;
     save();
     try {
       const response = await fetch(url);
-      if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText}`);
-      sweep = await response.json();
+      if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText || 'not found'}; a sweep data file of this build (figures/*.json) was expected`);
+      let json;
+      try {
+        json = await response.json();
+      } catch (e) {
+        throw new Error(`${url}: not JSON (${e.message}); a sweep data file as \`cmc33 sweep\` writes was expected`);
+      }
+      sweeps = sweepsOf(json, url);
     } catch (e) {
       error.textContent = e.message;
+      document.body.dataset.ready = `figures error ${url}`;
       return;
     }
+    partSelect.replaceChildren(...sweeps.map((s) => el('option', { value: s.name }, s.label)));
+    partSelect.hidden = sweeps.length < 2;
+    if (part && !sweeps.some((s) => s.name === part)) {
+      report(`part=${part}: ${url} has no sweep of that volume; it has ${sweeps.map((s) => s.name).join(', ')}.`);
+      part = '';
+    }
+    part ||= sweeps[0].name;
+    partSelect.value = part;
+    await choose();
+  }
+
+  async function choose() {
+    const keep = pick;
+    clear();
+    pick = keep;
+    sweep = sweeps.find((s) => s.name === part).sweep;
+    save();
     volumeName = sweep.volume.split('/').pop();
     about.textContent = `${volumeName}: ${sweep.dims.join('×')} ${sweep.type}, ${sweep.cells} cells; ${sweep.rows.length} rows, methods ${sweep.methods.join(', ')}.`;
     draw();
     if (Number.isFinite(pick)) await extractAt(pick);
-    document.body.dataset.ready = `figures ${url}`;
+    document.body.dataset.ready = `figures ${file}${sweeps.length > 1 ? ` ${part}` : ''}`;
   }
 
   function draw() {
-    for (const p of plots.splice(0)) p.destroy();
     const { isos, methods, byMethod } = seriesOf(sweep);
     const reference = byMethod.cmc33;
-    const others = methods.filter((m) => m !== 'cmc33');
     const showHover = (i) => {
       if (i === null || i === undefined) return;
       hover.replaceChildren(
@@ -125,33 +177,42 @@ export function figuresView(root, cmc33, state, setState) {
       );
     };
     const onClick = (i) => extractAt(isos[i]);
-    if (reference) {
-      plots.push(linePlot(fig13, {
-        x: isos,
-        series: others.map((m) => ({ label: `${m} − cmc33`, values: byMethod[m].map((r, i) => (r && reference[i] ? r.b0 - reference[i].b0 : NaN)), color: color(methods.indexOf(m)), points: true })),
-        xLabel: 'isovalue', yLabel: 'extra components', width: 520, height: 280, onCursor: showHover, onClick,
-      }));
+    const extra = (group) => group.map((m) => ({ label: `${m} − cmc33`, values: byMethod[m].map((r, i) => (r && reference[i] ? r.b0 - reference[i].b0 : NaN)), color: color(methods.indexOf(m)), points: true }));
+    const common = { x: isos, xLabel: 'isovalue', yLabel: 'extra components', width: 470, height: 260, onCursor: showHover, onClick };
+    // Fig. 13's two plots: classic MC's thousands would flatten MC33's few to a line at 0
+    const vtk = methods.filter((m) => m === 'mc');
+    const mc33 = methods.filter((m) => m !== 'cmc33' && m !== 'mc');
+    let plotVtk = null, plotMc33 = null;
+    if (!reference) {
+      fig13vtk.textContent = fig13mc33.textContent = 'This sweep has no cmc33 rows to compare with.';
     } else {
-      fig13.textContent = 'This sweep has no cmc33 rows to compare with.';
+      if (vtk.length) plots.push((plotVtk = linePlot(fig13vtk, { ...common, series: extra(vtk) })));
+      else fig13vtk.textContent = 'This sweep has no mc rows.';
+      if (mc33.length) plots.push((plotMc33 = linePlot(fig13mc33, { ...common, series: extra(mc33) })));
+      else fig13mc33.textContent = 'This sweep has no MC33 rows (mc33-lewiner, chernyaev, ...).';
     }
-    plots.push(linePlot(fig14, {
-      x: isos,
+    const plot14 = linePlot(fig14, {
+      ...common,
       series: methods.map((m) => ({ label: m, values: byMethod[m].map((r) => (r ? r.non_manifold_edges : NaN)), color: color(methods.indexOf(m)), points: true })),
-      xLabel: 'isovalue', yLabel: 'non-manifold edges', width: 520, height: 280, onCursor: showHover, onClick,
-    }));
+      yLabel: 'non-manifold edges',
+    });
+    plots.push(plot14);
     // for the browser tests: the plots' own data, which must be the sweep file's numbers
-    window.cmc33Page.figures = { isos, methods, fig13: plots.length === 2 ? plots[0] : null, fig14: plots[plots.length - 1] };
+    window.cmc33Page.figures = { isos, methods, fig13vtk: plotVtk, fig13mc33: plotMc33, fig14: plot14 };
   }
 
   async function extractAt(value) {
     pick = value;
     save();
+    const shown = sweep;
     try {
       if (!volume) {
         picked.textContent = `loading volumes/${volumeName}…`;
         const response = await fetch(`volumes/${volumeName}`);
         if (!response.ok) throw new Error(`volumes/${volumeName}: not bundled with this build (${response.status})`);
-        volume = cmc33.Volume.read(new Uint8Array(await response.arrayBuffer()), volumeName, {});
+        const bytes = new Uint8Array(await response.arrayBuffer());
+        if (sweep !== shown) return; // another sweep was chosen meanwhile
+        volume = cmc33.Volume.read(bytes, volumeName, {});
       }
       const t0 = performance.now();
       const mesh = takeMesh(volume.extract(value, method));
@@ -171,4 +232,3 @@ export function figuresView(root, cmc33, state, setState) {
 
   return { destroy() { volume?.delete(); for (const p of plots) p.destroy(); viewer.renderer.dispose(); } };
 }
-
