@@ -11,7 +11,7 @@ export const color = (i) => PALETTE[i % PALETTE.length];
 export function linePlot(target, { title = '', x, series, markers = [], xLabel = '', yLabel = '', zero = true, width = 420, height = 240, yRange = null, onCursor = null, onClick = null, xRange = null }) {
   const opts = {
     title,
-    width,
+    width: fitWidth(width),
     height,
     scales: { x: { time: false, ...(xRange ? { range: xRange } : {}) }, y: yRange ? { range: yRange } : {} },
     axes: [{ label: xLabel, size: 40 }, { label: yLabel, size: 60 }],
@@ -44,6 +44,8 @@ export function linePlot(target, { title = '', x, series, markers = [], xLabel =
             }
           }
           ctx.font = `${11 * devicePixelRatio}px sans-serif`;
+          ctx.textAlign = 'left'; // uPlot leaves the axes' alignment set: a label starts at its line
+          ctx.textBaseline = 'alphabetic';
           markers.forEach((m, i) => {
             if (m.x === undefined || m.x === null || Number.isNaN(m.x)) return;
             const px = u.valToPos(m.x, 'x', true);
@@ -57,6 +59,11 @@ export function linePlot(target, { title = '', x, series, markers = [], xLabel =
             ctx.setLineDash([]);
             ctx.fillStyle = m.color ?? '#444';
             ctx.fillText(m.label, px + 3, top + 12 * devicePixelRatio * (1 + (i % 3)));
+            if (Number.isFinite(m.y)) {
+              ctx.beginPath();
+              ctx.arc(px, u.valToPos(m.y, 'y', true), 4 * devicePixelRatio, 0, 2 * Math.PI);
+              ctx.fill();
+            }
           });
           ctx.restore();
         },
@@ -74,7 +81,18 @@ export function linePlot(target, { title = '', x, series, markers = [], xLabel =
     },
   };
   const data = [Array.from(x), ...series.map((s) => Array.from(s.values, (v) => (Number.isFinite(v) ? v : null)))];
-  return new uPlot(opts, data, target);
+  const plot = new uPlot(opts, data, target);
+  plot.markers = markers; // what the plot marks, for the browser tests
+  return plot;
+}
+
+/**
+ * A plot's or viewer's width: `width`, or less on a narrow screen (a phone), so that nothing makes
+ * the page scroll sideways: the page's width less the margins and a panel's padding.
+ */
+export function fitWidth(width, margin = 48) {
+  const page = document.documentElement.clientWidth || width + margin;
+  return Math.max(200, Math.min(width, page - margin));
 }
 
 /**
@@ -121,7 +139,7 @@ export function histogramPlot(target, { min, max, counts, iso, onPick, width = 4
   let current = iso;
   const plot = new uPlot(
     {
-      width,
+      width: fitWidth(width),
       height,
       scales: { x: { time: false } },
       axes: [{ label: 'sample value', size: 36 }, { label: 'log10(1 + count)', size: 50 }],

@@ -47,3 +47,10 @@ export const SUBCASE_CELLS = [
 export const APPENDIX_A = [0.2864, -0.0639, -0.1692, 0.6568, -0.2384, 0.9486, 0.1075, -0.5049];
 export const FIG9_CASE6 = [0.7724, -0.1254, -0.3594, 0.0369, -0.45, -0.2188, -0.5951, 0.6989];
 export const FIG8_SEED = 64;
+
+/**
+ * The paper's names of the corners, by library corner: its Appendix A table names the base z = 0
+ * A0, B0, C0, D0 going round from the origin and the top A1, B1, C1, D1 above them, so that
+ * APPENDIX_A is A0 = +0.2864, B0 = −0.0639, D0 = −0.1692, C0 = +0.6568, A1 = −0.2384, ...
+ */
+export const PAPER_NAMES = ['A0', 'B0', 'D0', 'C0', 'A1', 'B1', 'D1', 'C1'];

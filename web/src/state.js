@@ -36,3 +36,18 @@ export function el(tag, attrs = {}, ...children) {
   for (const c of children.flat()) if (c !== undefined && c !== null) node.append(c);
   return node;
 }
+
+/**
+ * A number the reader typed (or the address holds): decimal or exponent notation, a leading + or
+ * the typographic minus (−, as the paper and this page print it) allowed. Returns {value} or
+ * {error}, the error naming what was read and what was expected.
+ */
+export function parseNumber(text) {
+  const raw = String(text ?? '');
+  const s = raw.trim().replace(/^\u2212/, '-');
+  if (s === '') return { error: 'is empty; a number was expected, e.g. −0.2384' };
+  if (!/^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$/.test(s)) return { error: `“${raw}” is not a number; a decimal such as −0.2384 or 2.5e-3 was expected` };
+  const value = Number(s);
+  if (!Number.isFinite(value)) return { error: `“${raw}” is beyond the largest double (about 1.8e308); a finite number was expected` };
+  return { value };
+}

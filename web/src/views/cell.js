@@ -1,10 +1,10 @@
 // Cell explorer: eight corner values, the method's decisions on them (cmc33's analyze_cell), the
 // interior test's sweep as plots (Figs. 4, 6, 9), and the chosen triangulation beside the densely
 // sampled level set of the trilinear interpolant.
-import { el, fmt } from '../state.js';
+import { el, fmt, parseNumber } from '../state.js';
 import { linePlot, saddlePath } from '../plots.js';
 import { Viewer, surface, boxEdges, markers, COLORS } from '../viewer.js';
-import { SUBCASE_CELLS, APPENDIX_A, FIG9_CASE6 } from '../presets.js';
+import { SUBCASE_CELLS, APPENDIX_A, FIG9_CASE6, PAPER_NAMES } from '../presets.js';
 import { generator, randomValues } from '../search.js';
 import { takeMesh } from '../cmc33.js';
 
@@ -35,37 +35,72 @@ const CLAIMS = {
     'When t_alt falls outside (t1, t2), F(t_alt) < 0 and the tunnel is missed; the test at t_max = −b/2a finds it.',
 };
 
-export function cellView(root, cmc33, state, setState) {
+
+/** The address's cell= as up to 8 texts and what is wrong with it (null if nothing). */
+function addressCell(text) {
+  const parts = text.split(',');
+  const problems = [];
+  if (parts.length !== 8) {
+    problems.push(`cell=${text}: ${parts.length} value${parts.length === 1 ? '' : 's'}; 8 were expected, separated by commas, ` +
+      `in the library's corner order (${PAPER_NAMES.join(', ')})${parts.length > 8 ? `; the fields hold the first 8` : ''}.`);
+  }
+  parts.slice(0, 8).forEach((t, c) => {
+    const { error } = parseNumber(t);
+    if (error) problems.push(`cell=: corner ${c} (${PAPER_NAMES[c]}) ${error}.`);
+  });
+  return { texts: parts.slice(0, 8), problems };
+}
+
+export function cellView(root, cmc33, state, setState, report = () => {}) {
   const methods = cmc33.methods();
-  let values = (state.cell ?? APPENDIX_A.join(',')).split(',').map(Number);
-  if (values.length !== 8 || values.some((v) => !Number.isFinite(v))) values = APPENDIX_A.slice();
-  let iso = Number.isFinite(Number(state.iso)) ? Number(state.iso) : 0;
-  let method = methods.includes(state.method) ? state.method : 'cmc33';
+  let texts = APPENDIX_A.map(String);
+  if (state.cell !== undefined) {
+    const a = addressCell(state.cell);
+    texts = Array.from({ length: 8 }, (_, c) => a.texts[c] ?? '');
+    a.problems.forEach(report);
+  }
+  let values = texts.map((t) => parseNumber(t).value ?? NaN);
+  const isoText = state.iso ?? '0';
+  let iso = parseNumber(isoText).value ?? NaN;
+  if (state.iso !== undefined && !Number.isFinite(iso)) report(`iso=: ${parseNumber(isoText).error}.`);
+  let method = 'cmc33';
+  if (state.method !== undefined) {
+    if (methods.includes(state.method)) method = state.method;
+    else report(`method=${state.method}: no such method; the methods are ${methods.join(', ')}. cmc33 is used.`);
+  }
 
   const presetSelect = el('select', { id: 'cell-preset' }, el('option', { value: '' }, 'choose a cell…'),
     presets().map((p) => el('option', { value: p.id }, p.label)));
   const methodSelect = el('select', { id: 'cell-method' }, methods.map((m) => el('option', { value: m }, m)));
   methodSelect.value = method;
-  const isoInput = el('input', { id: 'cell-iso', type: 'number', step: 'any', value: iso, style: 'width:6rem' });
+  const isoInput = el('input', { id: 'cell-iso', type: 'text', inputmode: 'decimal', value: isoText, style: 'width:6rem', 'aria-describedby': 'cell-iso-error' });
+  const isoError = el('span', { class: 'field-error', id: 'cell-iso-error' });
   const randomButton = el('button', { id: 'cell-random' }, 'random cell');
 
-  const sliders = [], numbers = [], signs = [];
-  const cornerRows = values.map((v, c) => {
-    sliders[c] = el('input', { type: 'range', min: -1, max: 1, step: 0.0001, value: v, 'aria-label': `corner ${c} slider` });
-    numbers[c] = el('input', { type: 'number', step: 'any', value: v, id: `corner-${c}`, 'aria-label': `corner ${c}` });
+  const sliders = [], numbers = [], signs = [], fieldErrors = [];
+  const cornerRows = texts.map((t, c) => {
+    const v = values[c];
+    sliders[c] = el('input', { type: 'range', min: -1, max: 1, step: 0.0001, value: Number.isFinite(v) ? v : 0, 'aria-label': `corner ${c} (${PAPER_NAMES[c]}) slider` });
+    numbers[c] = el('input', { type: 'text', inputmode: 'decimal', value: t, id: `corner-${c}`, 'aria-label': `corner ${PAPER_NAMES[c]} (${c})`, 'aria-describedby': `corner-${c}-error`, dataset: { paper: PAPER_NAMES[c] } });
     signs[c] = el('span');
-    sliders[c].addEventListener('input', () => setCorner(c, Number(sliders[c].value)));
-    numbers[c].addEventListener('change', () => setCorner(c, Number(numbers[c].value)));
-    return el('div', { class: 'corner' }, el('span', {}, `corner ${c} (${cornerXYZ(c).join(',')}) `, signs[c]), sliders[c], numbers[c]);
+    fieldErrors[c] = el('span', { class: 'field-error', id: `corner-${c}-error` });
+    sliders[c].addEventListener('input', () => {
+      numbers[c].value = sliders[c].value;
+      setCorner(c);
+    });
+    numbers[c].addEventListener('change', () => setCorner(c));
+    return el('div', { class: 'corner' },
+      el('label', { for: `corner-${c}` }, el('b', { class: 'paper-name' }, PAPER_NAMES[c]), ` corner ${c} (${cornerXYZ(c).join(',')}) `, signs[c]),
+      sliders[c], numbers[c], fieldErrors[c]);
   });
 
   const claim = el('p', { class: 'claim', id: 'cell-claim' });
   const summary = el('div', { id: 'cell-summary' });
   const faces = el('table', { id: 'cell-faces' });
   const interior = el('div', { id: 'cell-interior' });
-  const plotF = el('div'), plotSaddle = el('div');
+  const plotF = el('div', { id: 'cell-plot-f' }), plotSaddle = el('div', { id: 'cell-plot-saddle' }), plotLewiner = el('div', { id: 'cell-plot-lewiner' });
   const pathCanvas = el('canvas', { class: 'path', width: 260, height: 260 });
-  const plotsBox = el('div', { class: 'row', id: 'cell-plots' }, plotF, plotSaddle, el('div', {}, el('div', {}, 'slice saddle x_c(t): black where f(x_c) ≥ iso'), pathCanvas));
+  const plotsBox = el('div', { class: 'row', id: 'cell-plots' }, plotF, plotLewiner, plotSaddle, el('div', {}, el('div', {}, 'slice saddle x_c(t): black where f(x_c) ≥ iso'), pathCanvas));
   const viewerBox = el('div', { class: 'viewer', id: 'cell-viewer' });
 
   root.append(
@@ -75,7 +110,8 @@ export function cellView(root, cmc33, state, setState) {
       el('div', { class: 'panel controls' },
         el('h3', {}, 'Corner values'),
         el('div', {}, el('label', {}, 'preset ', presetSelect), randomButton),
-        el('div', {}, el('label', {}, 'method ', methodSelect), el('label', {}, 'isovalue ', isoInput)),
+        el('div', {}, el('label', {}, 'method ', methodSelect), el('label', {}, 'isovalue ', isoInput), isoError),
+        el('p', { class: 'hint' }, 'A0 … D1 name the corners as the paper\'s Appendix A table does (base z = 0: A0, B0, C0, D0 going round; top: A1 … D1), so its values can be typed in as printed (+0.2864, −0.0639).'),
         ...cornerRows),
       el('div', { class: 'panel' }, el('h3', {}, 'Decisions'), summary, faces, interior)),
     el('div', { class: 'row' }, el('div', { class: 'panel' }, el('h3', {}, 'The cell in 3D'), viewerBox), el('div', { class: 'panel' }, el('h3', {}, 'Interior test: the sweep'), plotsBox)),
@@ -87,35 +123,59 @@ export function cellView(root, cmc33, state, setState) {
   presetSelect.addEventListener('change', () => {
     const p = presets().find((q) => q.id === presetSelect.value);
     if (p) {
-      values = p.values.slice();
-      iso = 0;
-      isoInput.value = 0;
-      refresh(true);
+      p.values.forEach((v, c) => (numbers[c].value = String(v)));
+      isoInput.value = '0';
+      refresh();
     }
   });
   randomButton.addEventListener('click', () => {
-    values = Array.from(randomValues(generator((Math.random() * 2 ** 32) >>> 0), 8));
-    refresh(true);
+    randomValues(generator((Math.random() * 2 ** 32) >>> 0), 8).forEach((v, c) => (numbers[c].value = String(v)));
+    refresh();
   });
   methodSelect.addEventListener('change', () => {
     method = methodSelect.value;
-    refresh(false);
+    refresh();
   });
-  isoInput.addEventListener('change', () => {
-    if (Number.isFinite(Number(isoInput.value))) iso = Number(isoInput.value);
-    refresh(false);
-  });
+  isoInput.addEventListener('change', () => refresh());
 
-  function setCorner(c, v) {
-    if (!Number.isFinite(v)) return;
-    values[c] = v;
-    refresh(false);
+  function setCorner() {
+    refresh();
   }
 
-  function refresh(syncInputs) {
+  /** Reads the fields: each is marked beside it when it is not a number; false if any is not. */
+  function readFields() {
+    let ok = true;
+    const read = (input, error, name) => {
+      const r = parseNumber(input.value);
+      error.textContent = r.error ? `${name} ${r.error}` : '';
+      input.setAttribute('aria-invalid', r.error ? 'true' : 'false');
+      if (r.error) ok = false;
+      return r.error ? NaN : r.value;
+    };
+    values = numbers.map((input, c) => read(input, fieldErrors[c], PAPER_NAMES[c]));
+    iso = read(isoInput, isoError, 'the isovalue');
+    return ok;
+  }
+
+  function clearResults(message) {
+    for (const p of plots.splice(0)) p.destroy();
+    claim.textContent = CLAIMS.default;
+    summary.replaceChildren(el('p', { class: 'error', id: 'cell-invalid' }, message));
+    faces.replaceChildren();
+    interior.replaceChildren();
+    plotsBox.style.display = 'none';
+    viewer.show([]);
+    document.body.dataset.ready = 'cell invalid';
+  }
+
+  function refresh() {
+    if (!readFields()) {
+      const bad = [...numbers.map((_, c) => (fieldErrors[c].textContent ? PAPER_NAMES[c] : null)), isoError.textContent ? 'the isovalue' : null].filter(Boolean);
+      clearResults(`No decision: ${bad.join(', ')} ${bad.length === 1 ? 'is' : 'are'} not a number (see beside the field${bad.length === 1 ? '' : 's'}).`);
+      return;
+    }
     values.forEach((v, c) => {
-      if (syncInputs || Number(numbers[c].value) !== v) numbers[c].value = v;
-      if (syncInputs || Number(sliders[c].value) !== v) sliders[c].value = Math.max(-1, Math.min(1, v));
+      if (Number(sliders[c].value) !== v) sliders[c].value = Math.max(-1, Math.min(1, v));
       const above = v >= iso;
       signs[c].textContent = above ? '+' : '−';
       signs[c].className = above ? 'sign-above' : 'sign-below';
@@ -168,7 +228,7 @@ export function cellView(root, cmc33, state, setState) {
     plotsBox.style.display = '';
     const lines = [
       ['test', i.test === 'tunnel' ? 'tunnel (Chernyaev, at t_max)' : '13.5 (Algorithm 1)'],
-      ['sweep', `along ${AXES[i.axis]} from corner A0 = ${i.cornerA} to C1 = ${i.cornerC}`],
+      ['sweep', `along ${AXES[i.axis]} from the tested corner ${i.cornerA} (this sweep's A0) to ${i.cornerC} (its C1)`],
       ['F(t) = a t² + b t + c', `a = ${fmt(i.a)}, b = ${fmt(i.b)}, c = ${fmt(i.c)}`],
       ['t_max = −b/2a', `${fmt(i.tMax)}, F(t_max) = ${fmt(i.fTMax)}`],
       ['roots of F', `t1 = ${fmt(i.t1)}, t2 = ${fmt(i.t2)}`],
@@ -179,18 +239,28 @@ export function cellView(root, cmc33, state, setState) {
     interior.replaceChildren(el('table', { id: 'cell-interior-table' }, lines.map(([k, v]) => el('tr', {}, el('td', {}, k), el('td', { style: 'text-align:left' }, v)))));
 
     const s = cmc33.sweep(new Float64Array(values), iso, i.axis, i.cornerA, 400);
-    const series = [{ label: 'F(t)', values: s.F }];
-    const lewinerSweep = i.lewinerAxis !== i.axis || i.lewinerCorner !== i.cornerA;
-    if (lewinerSweep) series.push({ label: 'F(t), Lewiner\'s sweep', values: cmc33.sweep(new Float64Array(values), iso, i.lewinerAxis, i.lewinerCorner, 400).F });
-    const den0 = s.den[0], den1 = s.den[s.den.length - 1];
-    const tA = den0 !== den1 ? den0 / (den0 - den1) : NaN;
     const marks = [
       { x: i.t1, label: 't1', color: '#2a9d4b' },
       { x: i.t2, label: 't2', color: '#2a9d4b' },
       { x: i.tMax, label: 't_max', color: '#d9534f' },
-      { x: i.tAlt, label: 't_alt', color: '#e08a00' },
     ];
-    plots.push(linePlot(plotF, { title: 'F(t) = A_t C_t − B_t D_t', x: s.t, series, markers: marks, xLabel: 't', xRange: [0, 1] }));
+    const den0 = s.den[0], den1 = s.den[s.den.length - 1];
+    const tA = den0 !== den1 ? den0 / (den0 - den1) : NaN;
+    plots.push(linePlot(plotF, {
+      title: `F(t) = A_t C_t − B_t D_t, along ${AXES[i.axis]} from corner ${i.cornerA}`,
+      x: s.t, series: [{ label: 'F(t)', values: s.F }], markers: marks, xLabel: 't', xRange: [0, 1],
+    }));
+    // t_alt is a height of Lewiner et al.'s own sweep (its axis and tested corner), so it is drawn
+    // on that sweep's F, on its own t axis, never on the plot above
+    const lewiner = cmc33.sweep(new Float64Array(values), iso, i.lewinerAxis, i.lewinerCorner, 400);
+    const same = i.lewinerAxis === i.axis && i.lewinerCorner === i.cornerA;
+    plots.push(linePlot(plotLewiner, {
+      title: `Lewiner's sweep: along ${AXES[i.lewinerAxis]} from corner ${i.lewinerCorner}${same ? ' (the same sweep)' : ''}`,
+      x: lewiner.t,
+      series: [{ label: 'F_Lewiner(t)', values: lewiner.F, color: '#e08a00' }],
+      markers: [{ x: i.tAlt, label: `t_alt, F = ${fmt(i.fTAlt)}`, color: '#e08a00', y: i.fTAlt }],
+      xLabel: 't (Lewiner\'s sweep)', xRange: [0, 1],
+    }));
     const bound = Math.max(...Array.from(s.F, Math.abs)) * 4 || 1;
     const clipped = Array.from(s.saddle, (v) => (Math.abs(v) > bound ? NaN : v));
     plots.push(linePlot(plotSaddle, {
@@ -201,6 +271,7 @@ export function cellView(root, cmc33, state, setState) {
       xLabel: 't',
       xRange: [0, 1],
     }));
+    window.cmc33Page.cell = { F: plots[0], lewiner: plots[1], saddle: plots[2] }; // for the browser tests
     saddlePath(pathCanvas, {
       u: s.u, v: s.v, saddle: s.saddle,
       marks: [{ u: i.saddle1[0], v: i.saddle1[1], label: 'x_c(t1)', color: '#2a9d4b' }, { u: i.saddle2[0], v: i.saddle2[1], label: 'x_c(t2)', color: '#2a9d4b' }],
@@ -225,6 +296,6 @@ export function cellView(root, cmc33, state, setState) {
     viewer.show(objects);
   }
 
-  refresh(true);
+  refresh();
   return { destroy() { for (const p of plots) p.destroy(); viewer.renderer.dispose(); } };
 }
