@@ -1,12 +1,19 @@
 // A three.js view: a scene of meshes, lines and markers, orbit controls, rendering on demand.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { fitWidth } from './plots.js';
 
 export const COLORS = { above: 0xd9534f, below: 0x3b6fb6, surface: 0xe8b64c, truth: 0x6fbf73, extra: 0x8a4fd1, bad: 0xff1493 };
 
 export class Viewer {
   constructor(container, { width = 640, height = 380, legend = '' } = {}) {
     this.container = container;
+    // narrower on a narrow screen (a phone), keeping the shape up to a point
+    const w = fitWidth(width, 56);
+    height = Math.round(height * Math.max(0.7, w / width));
+    width = w;
+    container.style.width = `${width}px`;
+    container.style.height = `${height}px`;
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
     this.renderer.setSize(width, height);
@@ -18,6 +25,10 @@ export class Viewer {
       this.legend.textContent = legend;
       container.append(this.legend);
     }
+    const hint = document.createElement('div');
+    hint.className = 'hint3d';
+    hint.textContent = 'drag: rotate · wheel or pinch: zoom · right-drag: pan';
+    container.append(hint);
     this.scene = new THREE.Scene();
     this.camera = new THREE.PerspectiveCamera(35, width / height, 0.01, 1e6);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x666677, 1.6));
@@ -59,6 +70,43 @@ export class Viewer {
     this.controls.target.copy(center);
     this.controls.update();
     this.fitted = true;
+  }
+
+  /** Frames the box [min, max] (seen from the same side as fit()), filling most of the view. */
+  fitBox(min, max) {
+    const box = new THREE.Box3(new THREE.Vector3(...min), new THREE.Vector3(...max));
+    const center = box.getCenter(new THREE.Vector3());
+    const size = box.getSize(new THREE.Vector3()).length();
+    // far enough that the box's bounding sphere fits the narrower of the view's angles
+    const half = THREE.MathUtils.degToRad(this.camera.fov / 2);
+    const narrow = Math.min(half, Math.atan(Math.tan(half) * this.camera.aspect));
+    this.camera.position.copy(center).add(new THREE.Vector3(0.55, -0.95, 0.75).normalize().multiplyScalar((size / 2 / Math.sin(narrow)) * 0.9));
+    this.camera.up.set(0, 0, 1);
+    this.camera.near = size / 1000;
+    this.camera.far = size * 100;
+    this.camera.updateProjectionMatrix();
+    this.controls.target.copy(center);
+    this.controls.update();
+    this.fitted = true;
+    this.render();
+  }
+
+  /**
+   * A given camera: looking at `focus` from `position`, `fov` degrees, and only what lies within
+   * `slab` of the focus's distance drawn (what is in front is clipped away), as a figure's zoom.
+   */
+  look(focus, position, { fov = 30, slab = Infinity } = {}) {
+    this.camera.position.set(...position);
+    this.camera.up.set(0, 0, 1);
+    this.camera.fov = fov;
+    const distance = new THREE.Vector3(...position).distanceTo(new THREE.Vector3(...focus));
+    this.camera.near = Number.isFinite(slab) ? Math.max(distance / 1000, distance - slab) : distance / 1000;
+    this.camera.far = Number.isFinite(slab) ? distance + slab : distance * 100;
+    this.camera.updateProjectionMatrix();
+    this.controls.target.set(...focus);
+    this.controls.update();
+    this.fitted = true;
+    this.render();
   }
 
   render() {
@@ -128,4 +176,28 @@ export function quad(corners, color, opacity = 0.35) {
   geometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(corners.flat()), 3));
   geometry.setIndex([0, 1, 2, 0, 2, 3]);
   return new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ color, side: THREE.DoubleSide, transparent: true, opacity, depthWrite: false }));
+}
+
+/** Moves the cameras of `viewers` together: rotating, zooming or panning one moves the others. */
+export function linkCameras(viewers) {
+  let syncing = false;
+  for (const v of viewers) {
+    v.controls.addEventListener('change', () => {
+      if (syncing) return;
+      syncing = true;
+      for (const w of viewers) {
+        if (w === v) continue;
+        w.camera.position.copy(v.camera.position);
+        w.camera.up.copy(v.camera.up);
+        w.camera.fov = v.camera.fov;
+        w.camera.near = v.camera.near;
+        w.camera.far = v.camera.far;
+        w.camera.updateProjectionMatrix();
+        w.controls.target.copy(v.controls.target);
+        w.controls.update();
+        w.render();
+      }
+      syncing = false;
+    });
+  }
 }
