@@ -466,7 +466,12 @@ test('a failed sweep load clears the previous sweep\'s description and plots', a
   assert.equal(await text('#figures-about'), '');
   assert.equal(await page.$$eval('#fig13-vtk canvas, #fig13-mc33 canvas, #fig14 canvas', (c) => c.length), 0);
   assert.equal(await page.evaluate(() => window.cmc33Page.figures), null);
-  // the 404 is the point here: chromium logs it as a console error, which is not the page's
+  // a link to a file that is not there: said at the top too, and the address is kept
+  const link = '#view=figures&data=figures/nothing.json';
+  await open(link, (r) => r?.startsWith('figures error'));
+  assert.match(await text('#address-problems'), /data=figures\/nothing\.json: 404 .*a sweep data file of this build/);
+  assert.equal(await hashNow(), link);
+  // the 404s are the point here: chromium logs them as console errors, which are not the page's
   const others = problems.splice(before).filter((p) => !/status of 404/.test(p));
   problems.push(...others);
 });

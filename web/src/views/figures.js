@@ -119,7 +119,6 @@ export function figuresView(root, cmc33, state, setState, report = () => {}) {
     clear();
     sweeps = [];
     partSelect.hidden = true;
-    save();
     try {
       const response = await fetch(url);
       if (!response.ok) throw new Error(`${url}: ${response.status} ${response.statusText || 'not found'}; a sweep data file of this build (figures/*.json) was expected`);
@@ -132,6 +131,9 @@ export function figuresView(root, cmc33, state, setState, report = () => {}) {
       sweeps = sweepsOf(json, url);
     } catch (e) {
       error.textContent = e.message;
+      // a file the address names: said at the top too, and the address is kept as given
+      if (url === state.data) report(`data=${url}: ${e.message.replace(`${url}: `, '')}`);
+      else save();
       document.body.dataset.ready = `figures error ${url}`;
       return;
     }
