@@ -18,6 +18,7 @@
 #include <optional>
 #include <string>
 
+#include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "slabs.hpp"
@@ -382,10 +383,19 @@ void print_json(const Json& json)
 void check_not_an_input(const std::string& output, const std::vector<std::string>& inputs)
 {
     for (const std::string& input : inputs) {
-        std::error_code ec;
-        if (fs::equivalent(input, output, ec) && !ec) {
-            throw UsageError(output + " is the input " + (input == output ? "file" : input + " under another name") +
-                             "; write the output to another file, a command never replaces what it reads");
+        // The header first, then every data file it names.
+        const std::vector<fs::path> files = io::volume_files(input);
+        for (std::size_t i = 0; i < files.size(); ++i) {
+            std::error_code ec;
+            if (!fs::equivalent(files[i], output, ec) || ec) continue;
+            const std::string advice = "; write the output to another file, a command never replaces what it reads";
+            if (i == 0) {
+                throw UsageError(output + " is the input " + (input == output ? "file" : input + " under another name") +
+                                 advice);
+            }
+            const std::string data = files[i].string();
+            throw UsageError(output + " is " + (data == output ? "" : data + " under another name, ") +
+                             "a data file of the input " + input + advice);
         }
     }
 }
@@ -427,9 +437,14 @@ void check_mesh_output(const std::string& output, bool ascii, bool normals, cons
         throw UsageError(output + ": OFF/STL cannot store normals; use .ply or .obj, or drop --normals");
     }
     check_not_an_input(output, inputs);
-    const fs::path dir = path.has_parent_path() ? path.parent_path() : fs::path(".");
+    // A directory, a device, a read-only file: refused now, as the writer would refuse them.
+    const fs::path target = io::detail::output_target(path).target;
+    const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
     std::error_code ec;
-    if (fs::is_directory(path, ec)) throw Error(Status::io_error, output + ": cannot write: it is a directory");
+    if (target != path && !fs::is_directory(dir, ec)) {
+        throw Error(Status::io_error, output + ": cannot write: it is a symbolic link to " + target.string() +
+                                          ", whose directory " + dir.string() + " does not exist");
+    }
     check_writable_folder(dir, output);
 }
 

@@ -81,8 +81,9 @@ CLI::Validator memory_size();
 /// first in main(), before any thread starts.
 void install_signal_cleanup();
 
-/// UsageError if `output` names the same file as one of `inputs` (also through a link or another
-/// spelling): a command must never overwrite what it reads.
+/// UsageError if `output` names the same file as one of `inputs` or one of the data files their
+/// headers name (io::volume_files), also through a link or another spelling: a command must never
+/// overwrite what it reads.
 void check_not_an_input(const std::string& output, const std::vector<std::string>& inputs);
 /// Error{io_error} naming the folder unless `dir` is an existing folder in which a file can be
 /// created (tried: root passes a permission test on a read-only file system).
@@ -124,9 +125,10 @@ Json geometry_json(const MeshGeometry& geometry);
 void print_json(const Json& json);
 
 /// If `output` is not empty: throws, before any work is done, what write_mesh would throw for
-/// it (unknown extension: the library's Error; a missing or non-writable directory:
-/// Error{io_error}), and a UsageError for --ascii with anything but .ply, for --normals
-/// (`normals`) with .off or .stl, and for an output that is one of `inputs`.
+/// it (unknown extension: the library's Error; a missing or non-writable directory, a directory,
+/// a device, a read-only file: Error{io_error}), and a UsageError for --ascii with anything but
+/// .ply, for --normals (`normals`) with .off or .stl, and for an output that is one of `inputs`
+/// or of their data files. A symbolic link is checked where it leads (it is written through).
 void check_mesh_output(const std::string& output, bool ascii, bool normals = false,
                        const std::vector<std::string>& inputs = {});
 

@@ -296,9 +296,10 @@ OutputTarget output_target(const std::filesystem::path& path)
     struct stat st {};
     for (int links = 0;; ++links) {
         if (::lstat(p.c_str(), &st) != 0) {
-            // A new file (or the new target of a dangling link); other errors show when it is created.
+            const int error = errno;
             output.target = p;
-            return output;
+            if (error == ENOENT) return output; // a new file (or the new target of a dangling link)
+            throw Error(Status::io_error, path.string() + ": cannot write: " + reason(error) + through(path, p));
         }
         if (!S_ISLNK(st.st_mode)) break;
         if (links == kMaxLinks) {
