@@ -390,8 +390,8 @@ void check_not_an_input(const std::string& output, const std::vector<std::string
             if (!fs::equivalent(files[i], output, ec) || ec) continue;
             const std::string advice = "; write the output to another file, a command never replaces what it reads";
             if (i == 0) {
-                throw UsageError(output + " is the input " + (input == output ? "file" : input + " under another name") +
-                                 advice);
+                throw UsageError(output + " is the input " +
+                                 (input == output ? "file" : input + " under another name") + advice);
             }
             const std::string data = files[i].string();
             throw UsageError(output + " is " + (data == output ? "" : data + " under another name, ") +

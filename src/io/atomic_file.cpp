@@ -175,7 +175,13 @@ std::filesystem::path temporary_name(const std::filesystem::path& path)
 /// Returns the descriptor, or -1 with `error` set (the temporary is not left behind).
 int create_file(const std::filesystem::path& temp, const OutputTarget& output, int& error)
 {
-    const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, output.exists ? 0600 : 0666);
+    const auto open_new = [&] {
+        return ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, output.exists ? 0600 : 0666);
+    };
+    int fd = open_new();
+    if (fd < 0 && errno == EEXIST && ::unlink(temp.c_str()) == 0) {
+        fd = open_new(); // a leftover of a killed process that had this pid: its temporaries are ours to remove
+    }
     if (fd < 0) {
         error = errno;
         return -1;
@@ -309,8 +315,8 @@ OutputTarget output_target(const std::filesystem::path& path)
         std::error_code ec;
         const std::filesystem::path to = std::filesystem::read_symlink(p, ec);
         if (ec) {
-            throw Error(Status::io_error, path.string() + ": cannot write: cannot read the symbolic link " + p.string() +
-                                              " (" + ec.message() + ")");
+            throw Error(Status::io_error, path.string() + ": cannot write: cannot read the symbolic link " +
+                                              p.string() + " (" + ec.message() + ")");
         }
         p = to.is_absolute() ? to : p.parent_path() / to;
     }
@@ -396,7 +402,8 @@ void PositionalFile::write_at(std::uint64_t offset, const void* data, std::size_
 {
     const auto* p = static_cast<const unsigned char*>(data);
     while (count > 0) {
-        const ::ssize_t n = ::pwrite(fd_, p, std::min<std::size_t>(count, std::size_t{1} << 30), static_cast<::off_t>(offset));
+        const ::ssize_t n =
+            ::pwrite(fd_, p, std::min<std::size_t>(count, std::size_t{1} << 30), static_cast<::off_t>(offset));
         if (n < 0 && errno == EINTR) continue;
         if (n <= 0) {
             throw Error(Status::io_error, path_.string() + ": writing failed at byte " + std::to_string(offset) + " (" +

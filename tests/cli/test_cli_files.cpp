@@ -55,7 +55,8 @@ void expect_failure(const Result& r, const std::vector<std::string>& parts)
     EXPECT_EQ(r.code, 1) << r.err;
     EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    for (const std::string& part : parts) EXPECT_NE(r.err.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
+    for (const std::string& part : parts)
+        EXPECT_NE(r.err.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
     EXPECT_EQ(r.out, "");
 }
 
@@ -66,7 +67,8 @@ void expect_usage_error(const Result& r, const std::vector<std::string>& parts)
     EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
     const std::string first = r.err.substr(0, r.err.find('\n'));
-    for (const std::string& part : parts) EXPECT_NE(first.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
+    for (const std::string& part : parts)
+        EXPECT_NE(first.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
     EXPECT_EQ(r.out, "");
 }
 
@@ -108,8 +110,9 @@ TEST(CliFiles, ADataFileIsAnInputUnderEveryName)
         for (const fs::path& out : {dir / "samples.ply", dir / "." / "samples.ply", dir / "sub" / ".." / "samples.ply",
                                     dir / "hard.obj", dir / "soft.stl"}) {
             SCOPED_TRACE(header.string() + " -o " + out.string());
-            expect_usage_error(run(extract(header, out)), {out.string() + " is ", "a data file of the input " + header.string(),
-                                                           "never replaces what it reads"});
+            expect_usage_error(
+                run(extract(header, out)),
+                {out.string() + " is ", "a data file of the input " + header.string(), "never replaces what it reads"});
             // --memory-limit reads slab by slab from the same data file.
             if (out.extension() == ".ply") {
                 expect_usage_error(run(extract(header, out, " --memory-limit 1M")), {"a data file of the input"});
@@ -137,7 +140,8 @@ TEST(CliFiles, DataFilesInOtherFoldersAndThroughLinks)
     fs::create_directories(dir / "d");
     test::write_file(dir / "d" / "s.ply", ball_samples());
     test::write_file(dir / "h" / "vol.nhdr", std::string(kNrrdFields) + "data file: ../d/s.ply\n");
-    test::write_file(dir / "h" / "abs.nhdr", std::string(kNrrdFields) + "data file: " + (dir / "d" / "s.ply").string() + "\n");
+    test::write_file(dir / "h" / "abs.nhdr",
+                     std::string(kNrrdFields) + "data file: " + (dir / "d" / "s.ply").string() + "\n");
     // A header reached through a link: its data file is named relative to the link's folder, as read.
     fs::create_directories(dir / "l");
     fs::create_symlink(dir / "h" / "vol.nhdr", dir / "l" / "link.nhdr");
@@ -208,7 +212,8 @@ TEST(CliFiles, NrrdChannelsAreRefused)
     const Result ok = run(extract(dir / "ok.nrrd", dir / "out.ply"));
     EXPECT_EQ(ok.code, 0) << ok.err;
     // MetaImage: channels were refused already.
-    test::write_file(dir / "rgb.mha", std::string(kMetaFields) + "ElementNumberOfChannels = 3\nElementDataFile = LOCAL\n" +
+    test::write_file(dir / "rgb.mha", std::string(kMetaFields) +
+                                          "ElementNumberOfChannels = 3\nElementDataFile = LOCAL\n" +
                                           std::string(1536, '\x64'));
     expect_failure(run(extract(dir / "rgb.mha", dir / "rgb.ply")), {"ElementNumberOfChannels = 3"});
     EXPECT_FALSE(fs::exists(dir / "rgb.ply"));

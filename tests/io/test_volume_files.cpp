@@ -63,7 +63,8 @@ TEST(VolumeFiles, NrrdSingleDataFileRelativeToTheHeader)
     const fs::path dir = temp_dir();
     fs::create_directory(dir / "h");
     write_file(dir / "h" / "v.nhdr", std::string(kNrrdFields) + "data file: ../d/samples.raw\n");
-    EXPECT_EQ(volume_files(dir / "h" / "v.nhdr"), (std::vector<fs::path>{dir / "h" / "v.nhdr", dir / "h" / "../d/samples.raw"}));
+    EXPECT_EQ(volume_files(dir / "h" / "v.nhdr"),
+              (std::vector<fs::path>{dir / "h" / "v.nhdr", dir / "h" / "../d/samples.raw"}));
     // The old one-word spelling, blanks around the name, an attached .nrrd with a data file.
     write_file(dir / "a.nrrd", std::string(kNrrdFields) + "datafile:   s.raw  \n\n");
     EXPECT_EQ(volume_files(dir / "a.nrrd"), paths(dir, {"a.nrrd", "s.raw"}));
@@ -183,8 +184,8 @@ TEST(VolumeKinds, NonSpatialAxesAreRefusedNamingTheAxis)
 TEST(VolumeKinds, DomainKindsAreRead)
 {
     const fs::path dir = temp_dir();
-    for (const std::string kinds : {"domain domain domain", "space space space", "space space time", "??? none domain",
-                                    "Domain SPACE space"}) {
+    for (const std::string kinds :
+         {"domain domain domain", "space space space", "space space time", "??? none domain", "Domain SPACE space"}) {
         SCOPED_TRACE(kinds);
         write_file(dir / "v.nrrd", nrrd_with_kinds("3", "2 3 4", kinds, 24));
         const Volume v = read_volume(dir / "v.nrrd");
@@ -318,6 +319,19 @@ TEST(AtomicWrite, NamesOfTheLongestLength)
     EXPECT_EQ(temp_name.find(".tmp"), detail::kTemporaryNameBytes);
     EXPECT_EQ(temp_name.substr(0, 64), "." + accents.substr(0, 63));
     EXPECT_TRUE(fs::is_empty(dir));
+}
+
+TEST(AtomicWrite, ALeftoverTemporaryOfThisPidIsReplaced)
+{
+    // A killed process with this pid left the name the next temporary takes.
+    const fs::path dir = temp_dir();
+    const std::string name = detail::temporary_beside(dir / "m.ply").filename().string(); // .m.ply.tmpPID-N
+    const std::size_t dash = name.rfind('-');
+    const std::string next = name.substr(0, dash + 1) + std::to_string(std::stoul(name.substr(dash + 1)) + 1);
+    write_file(dir / next, "stale");
+    write_text(dir / "m.ply", "new");
+    EXPECT_EQ(read_file(dir / "m.ply"), "new");
+    EXPECT_FALSE(fs::exists(dir / next));
 }
 
 TEST(AtomicWrite, ACreateFailureSaysWhy)
