@@ -35,8 +35,7 @@ const CLAIMS = {
     'When t_alt falls outside (t1, t2), F(t_alt) < 0 and the tunnel is missed; the test at t_max = −b/2a finds it.',
 };
 
-
-/** The address's cell= as up to 8 texts and what is wrong with it (null if nothing). */
+/** The address's cell= as up to 8 texts, and what is wrong with it (a list, empty if nothing). */
 function addressCell(text) {
   const parts = text.split(',');
   const problems = [];
@@ -86,9 +85,9 @@ export function cellView(root, cmc33, state, setState, report = () => {}) {
     fieldErrors[c] = el('span', { class: 'field-error', id: `corner-${c}-error` });
     sliders[c].addEventListener('input', () => {
       numbers[c].value = sliders[c].value;
-      setCorner(c);
+      refresh();
     });
-    numbers[c].addEventListener('change', () => setCorner(c));
+    numbers[c].addEventListener('change', () => refresh());
     return el('div', { class: 'corner' },
       el('label', { for: `corner-${c}` }, el('b', { class: 'paper-name' }, PAPER_NAMES[c]), ` corner ${c} (${cornerXYZ(c).join(',')}) `, signs[c]),
       sliders[c], numbers[c], fieldErrors[c]);
@@ -137,10 +136,6 @@ export function cellView(root, cmc33, state, setState, report = () => {}) {
     refresh();
   });
   isoInput.addEventListener('change', () => refresh());
-
-  function setCorner() {
-    refresh();
-  }
 
   /** Reads the fields: each is marked beside it when it is not a number; false if any is not. */
   function readFields() {
