@@ -10,6 +10,7 @@
 #include "cmc33/verify.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "plural.hpp"
 
 namespace cmc33::cli {
 
@@ -41,14 +42,15 @@ void run_dataset(const DatasetArgs& args)
         end_progress_line();
         throw;
     }
-    std::cout << "wrote " << s.written[0] << " cells, " << s.written[1] << " grids, " << s.written[2]
-              << " closed grids and " << s.written[3] << " tie grids to " << args.output
+    std::cout << "wrote " << counted(s.written[0], "cell") << ", " << counted(s.written[1], "grid") << ", "
+              << counted(s.written[2], "closed grid") << " and " << counted(s.written[3], "tie grid") << " to " << args.output
               << "/ (manifest.tsv, README.txt) in " << sig(s.seconds, 3) << " s\n";
     const std::int64_t left_out = s.undetermined[0] + s.undetermined[1] + s.undetermined[2] + s.undetermined[3];
     if (left_out != 0) {
-        std::cout << "left out " << left_out << " fields whose topology is undetermined ("
-                  << s.undetermined[0] << " cells, " << s.undetermined[1] << " grids, "
-                  << s.undetermined[2] << " closed, " << s.undetermined[3] << " ties): their numbers are missing\n";
+        std::cout << "left out " << counted(left_out, "field") << " whose topology is undetermined ("
+                  << counted(s.undetermined[0], "cell") << ", " << counted(s.undetermined[1], "grid") << ", "
+                  << s.undetermined[2] << " closed, " << counted(s.undetermined[3], "tie")
+                  << "): their numbers are missing\n";
     }
     std::cout << "check an extractor with: cmc33 verify --dataset " << args.output
               << " --cmd 'TOOL {in} {iso} {out}'\n";

@@ -2,12 +2,14 @@
 
 #include <iostream>
 #include <memory>
+#include <new>
 #include <string>
 
 #include "cmc33/io.hpp"
 #include "cmc33/topology.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "plural.hpp"
 
 namespace cmc33::cli {
 
@@ -26,7 +28,20 @@ void run_topo(const TopoArgs& args)
     const Mesh mesh = named_step(args.input, "reading the mesh", [&] { return io::read_mesh(args.input); });
     const MeshTopology t = named_step(args.input, "computing the mesh's topology", [&] { return mesh_topology(mesh); });
     MeshGeometry g;
-    if (args.geometry) g = named_step(args.input, "checking the mesh's geometry", [&] { return mesh_geometry(mesh); });
+    if (args.geometry) {
+        try {
+            g = mesh_geometry(mesh);
+        } catch (const Error& e) {
+            // the library's "mesh_geometry: " is a function name; the user needs the way around it
+            std::string why = e.what();
+            if (const std::string prefix = "mesh_geometry: "; why.starts_with(prefix)) why.erase(0, prefix.size());
+            throw Error(e.status(), args.input + ": cannot check the mesh in space: " + why +
+                                        "; --no-geometry gives its topology without that check");
+        } catch (const std::bad_alloc&) {
+            throw Error(Status::too_large, args.input + ": out of memory while checking the mesh in space; "
+                                                        "--no-geometry gives its topology without that check");
+        }
+    }
     if (args.json) {
         Json out{{"file", args.input},
                  {"vertices", t.vertices},
@@ -38,11 +53,11 @@ void run_topo(const TopoArgs& args)
         print_json(out);
         return;
     }
-    std::cout << args.input << ": " << t.vertices << " vertices, " << t.edges << " edges, " << t.faces
-              << " faces";
+    std::cout << args.input << ": " << counted(t.vertices, "vertex", "vertices") << ", " << counted(t.edges, "edge")
+              << ", " << counted(t.faces, "face");
     if (static_cast<std::int64_t>(mesh.vertex_count()) != t.vertices) {
         const std::int64_t unused = static_cast<std::int64_t>(mesh.vertex_count()) - t.vertices;
-        std::cout << " (the file has " << mesh.vertex_count() << " vertices; " << unused
+        std::cout << " (the file has " << counted(mesh.vertex_count(), "vertex", "vertices") << "; " << unused
                   << (unused == 1 ? " is" : " are") << " used by no triangle)";
     }
     std::cout << '\n'
@@ -55,15 +70,15 @@ void run_topo(const TopoArgs& args)
               << "degenerate triangles " << t.degenerate_triangles << '\n'
               << "closed " << yes_no(t.closed) << ", oriented " << yes_no(t.oriented) << '\n';
     if (args.geometry) {
-        std::cout << "in space: " << (g.embedded() ? "embedded" : "NOT embedded") << "; " << g.positions
-                  << " distinct positions, coincident vertices " << g.coincident_vertices
+        std::cout << "in space: " << (g.embedded() ? "embedded" : "NOT embedded") << "; "
+                  << counted(g.positions, "distinct position") << ", coincident vertices " << g.coincident_vertices
                   << ", zero-area triangles " << g.zero_area_triangles << ", intersecting triangle pairs "
                   << g.intersecting_pairs << '\n';
         for (const auto& pair : g.intersection_examples) {
             std::cout << "  triangles " << pair[0] << " and " << pair[1] << " meet improperly\n";
         }
         const MeshTopology& w = g.welded;
-        std::cout << "welded by position: " << w.vertices << " vertices, euler " << w.euler << ", betti "
+        std::cout << "welded by position: " << counted(w.vertices, "vertex", "vertices") << ", euler " << w.euler << ", betti "
                   << w.components << " " << w.b1 << " " << w.closed_components << ", boundary loops "
                   << w.boundary_loops << ", non-manifold edges " << w.nonmanifold_edges
                   << ", non-manifold vertices " << w.nonmanifold_vertices << '\n';

@@ -20,6 +20,7 @@
 #include "cmc33/verify.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "plural.hpp"
 
 namespace cmc33::cli {
 
@@ -52,6 +53,7 @@ struct VerifyArgs {
     std::vector<CLI::Option*> random_only; ///< options that make no sense with --dataset
 };
 
+constexpr std::array<std::string_view, kFieldKindCount> kKindSingular = {"cell", "grid", "closed", "tie"};
 constexpr std::array<std::string_view, kFieldKindCount> kKindPlural = {"cells", "grids", "closed", "ties"};
 
 /// --method NAME, repeated or comma-separated; "all" for the five. Default: cmc33 alone (the
@@ -153,12 +155,11 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
     for (int k = 0; k < kFieldKindCount; ++k) {
         const auto i = static_cast<std::size_t>(k);
         if (r.fields[i] == 0) continue;
-        head += " " + std::to_string(r.fields[i]) + " " + std::string(kKindPlural[i]);
+        head += " " + counted(r.fields[i], kKindSingular[i], kKindPlural[i]);
         if (k != 0 && args.dataset.empty()) head += " " + std::to_string(r.size) + "^3";
         head += " (" + rate_text(r.rate(static_cast<FieldKind>(k))) + "/s),";
     }
-    std::cout << head << " " << r.threads << (r.threads == 1 ? " thread, " : " threads, ")
-              << sig(r.seconds, 3) << " s\n";
+    std::cout << head << " " << counted(r.threads, "thread") << ", " << sig(r.seconds, 3) << " s\n";
     if (!args.command.empty()) std::cout << "command: " << args.command << '\n';
     std::cout << '\n';
 
@@ -180,11 +181,11 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
                  " field's (else it counts under topology), it is manifold, and it is embedded in space)\n";
     for (const MethodReport& m : r.methods) {
         if (m.errors != 0)
-            std::cout << m.name << ": " << m.errors << " fields gave no mesh"
+            std::cout << m.name << ": " << counted(m.errors, "field") << " gave no mesh"
                       << (m.first_error.empty() ? "" : "; the first, " + m.first_error)
                       << (r.failures_dir.empty() ? "" : " (all in failures.tsv)") << '\n';
         if (m.unoriented != 0)
-            std::cout << m.name << ": " << m.unoriented << " meshes not consistently oriented\n";
+            std::cout << m.name << ": " << counted(m.unoriented, "mesh", "meshes") << " not consistently oriented\n";
     }
 
     // Per subcase, topology mismatches only: single cells (each is the one subcase the method
@@ -222,7 +223,7 @@ void print_report(const VerifyReport& r, const VerifyArgs& args)
           });
     if (r.failures_written != 0) {
         std::cout << "\n"
-                  << r.failures_written << " failures written to " << r.failures_dir.string()
+                  << counted(r.failures_written, "failure") << " written to " << r.failures_dir.string()
                   << "/ (listed in " << (r.failures_dir / "failures.tsv").string()
                   << " with the commands that reproduce them)\n";
     }

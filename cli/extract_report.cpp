@@ -6,6 +6,8 @@
 #include <iostream>
 #include <string>
 
+#include "plural.hpp"
+
 namespace cmc33::cli {
 
 void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
@@ -33,10 +35,10 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
                  {"output", args.output.empty() ? Json(nullptr) : Json(args.output)},
                  {"topology", !args.no_topology ? topology_json(r.topology) : Json(nullptr)},
                  {"geometry", geometry},
-                 {"subcases", subcases},
                  // cmc33-paper: planes the Sec. 6.2 refinement added (0: none needed); null for the others
                  {"refinement_planes", r.method == Method::cmc33_paper ? Json(r.stats.refinement_planes) : Json(nullptr)}};
         for (auto it = r.extra.begin(); it != r.extra.end(); ++it) out[it.key()] = it.value();
+        out["subcases"] = subcases; // last, as in docs/cli.md's table: the long one
         print_json(out);
         return;
     }
@@ -44,8 +46,8 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
     const MeshGeometry& geometry = r.geometry;
     std::string line = args.input + ": " + dims_text(r.dims) + " " + std::string(type_name(r.type)) +
                        ", iso " + num(args.iso) + ", " + std::string(method_name(r.method)) + ": " +
-                       std::to_string(r.vertices) + " vertices, " +
-                       std::to_string(r.triangles) + " triangles in " + sig(r.seconds, 3) + " s";
+                       counted(r.vertices, "vertex", "vertices") + ", " + counted(r.triangles, "triangle") + " in " +
+                       sig(r.seconds, 3) + " s";
     if (args.repeat > 1) line += " (median of " + std::to_string(args.repeat) + ")";
     if (!args.no_topology) {
         line += "; euler " + std::to_string(topology.euler) + ", components " +
@@ -58,10 +60,10 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
     }
     if (!args.no_topology) {
         line += geometry.embedded() ? ", embedded"
-                                    : ", NOT embedded (" + std::to_string(geometry.coincident_vertices) +
-                                          " coincident vertices, " + std::to_string(geometry.zero_area_triangles) +
-                                          " zero-area triangles, " + std::to_string(geometry.intersecting_pairs) +
-                                          " intersecting triangle pairs)";
+                                    : ", NOT embedded (" +
+                                          counted(geometry.coincident_vertices, "coincident vertex", "coincident vertices") +
+                                          ", " + counted(geometry.zero_area_triangles, "zero-area triangle") + ", " +
+                                          counted(geometry.intersecting_pairs, "intersecting triangle pair") + ")";
     }
     if (!args.output.empty()) line += " (" + args.output + ")";
     std::cout << line << '\n';

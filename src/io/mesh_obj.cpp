@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mesh_formats.hpp"
+#include "plural.hpp"
 
 namespace cmc33::io::detail {
 namespace {
@@ -45,7 +46,7 @@ struct ObjReader {
         for (int k = 0; k < 3; ++k) {
             if (!in.next_token_in_line(token)) {
                 fail(Status::bad_format,
-                     concat("\"", keyword, "\" has ", k, " numbers; expected 3"));
+                     concat("\"", keyword, "\" has ", counted(k, "number"), "; expected 3"));
             }
             float value = 0;
             if (!parse_float(token, value)) {
@@ -60,6 +61,7 @@ struct ObjReader {
     std::int64_t resolve(std::string_view text, std::size_t count, const char* what)
     {
         const char* plural = std::string_view(what) == "vertex" ? "vertices" : "normals";
+        const std::string_view are = count == 1 ? " is" : " are";
         std::int64_t index = 0;
         if (!parse_int(text, index)) {
             fail(Status::bad_format, concat(quote_text(text), " is not a ", what, " index"));
@@ -68,7 +70,7 @@ struct ObjReader {
         if (index < 0) {
             if (static_cast<std::uint64_t>(-(index + 1)) >= count) {
                 fail(Status::bad_format, concat("relative ", what, " index ", index, " but only ",
-                                                count, " ", plural, " are defined so far"));
+                                                counted(count, what, plural), are, " defined so far"));
             }
             return static_cast<std::int64_t>(count) + index;
         }
@@ -85,8 +87,9 @@ struct ObjReader {
             const std::int64_t vertex = resolve(vertex_text, mesh.vertex_count(), "vertex");
             if (static_cast<std::uint64_t>(vertex) >= mesh.vertex_count()) {
                 fail(Status::bad_format,
-                     concat("vertex index ", vertex + 1, " but only ", mesh.vertex_count(),
-                            " vertices are defined before this face"));
+                     concat("vertex index ", vertex + 1, " but only ",
+                            counted(mesh.vertex_count(), "vertex", "vertices"),
+                            mesh.vertex_count() == 1 ? " is" : " are", " defined before this face"));
             }
             std::uint32_t normal = kNoNormal;
             if (slash != std::string_view::npos) {
@@ -96,8 +99,8 @@ struct ObjReader {
                         resolve(token.substr(second + 1), file_normals.size() / 3, "normal");
                     if (n >= static_cast<std::int64_t>(file_normals.size() / 3)) {
                         fail(Status::bad_format,
-                             concat("normal index ", n + 1, " but only ", file_normals.size() / 3,
-                                    " normals are defined"));
+                             concat("normal index ", n + 1, " but only ", counted(file_normals.size() / 3, "normal"),
+                                    file_normals.size() / 3 == 1 ? " is" : " are", " defined"));
                     }
                     normal = static_cast<std::uint32_t>(n);
                 }
@@ -107,7 +110,7 @@ struct ObjReader {
         }
         if (polygon.size() < 3) {
             fail(Status::bad_format,
-                 concat("a face with ", polygon.size(), " vertices; expected at least 3"));
+                 concat("a face with ", counted(polygon.size(), "vertex", "vertices"), "; expected at least 3"));
         }
         for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
             mesh.triangles.push_back(polygon[0]);

@@ -4,6 +4,7 @@
 // from its own line, so trailing colours or texture coordinates are ignored whatever their
 // count. Polygons are fanned. Binary OFF and the 4D / nD variants are not supported.
 
+#include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -11,6 +12,7 @@
 #include <vector>
 
 #include "mesh_formats.hpp"
+#include "plural.hpp"
 
 namespace cmc33::io::detail {
 
@@ -71,15 +73,17 @@ Mesh read_off(std::string_view bytes, const std::string& name)
     }
     in.skip_line();
 
-    // Every vertex line holds at least "0 0 0\n", every face line "3 0 0 0\n".
+    // Every vertex line holds at least "0 0 0\n", every face line its count "0\n": a face of 0 or 2
+    // vertices is then reported on its own line, not as a file too short for the counts.
     const std::uint64_t remaining = in.remaining() + 1;
     const std::uint64_t vertex_min = normals ? 12 : 6;
     const auto v = static_cast<std::uint64_t>(vertex_count),
                f = static_cast<std::uint64_t>(face_count);
-    if (v > remaining / vertex_min || f > remaining / 8 || v * vertex_min + f * 8 > remaining) {
+    if (v > remaining / vertex_min || f > remaining / 2 || v * vertex_min + f * 2 > remaining) {
         fail(Status::truncated_file,
-             concat("the counts declare ", v, " vertices and ", f, " faces (at least ",
-                    v * vertex_min + f * 8, " bytes) but only ", in.remaining(), " bytes follow"));
+             concat("the counts declare ", counted(v, "vertex", "vertices"), " and ", counted(f, "face"),
+                    " (at least ", counted(v * vertex_min + f * 2, "byte"), ") but only ",
+                    counted(in.remaining(), "byte"), " follow"));
     }
     if (v > std::numeric_limits<std::uint32_t>::max()) {
         fail(Status::too_large, concat(v, " vertices; at most 4294967295 (32-bit indices)"));
@@ -88,15 +92,15 @@ Mesh read_off(std::string_view bytes, const std::string& name)
     Mesh mesh;
     mesh.positions.resize(3 * v);
     if (normals) mesh.normals.resize(3 * v);
-    mesh.triangles.reserve(3 * f);
+    mesh.triangles.reserve(3 * std::min(f, remaining / 8)); // room for at most that many "3 i j k\n"
     for (std::uint64_t i = 0; i < v; ++i) {
         if (!in.next_token(token)) {
-            fail(Status::truncated_file, concat("the file ends after ", i, " of ", v, " vertices"));
+            fail(Status::truncated_file, concat("the file ends after ", i, " of ", counted(v, "vertex", "vertices")));
         }
         for (int k = 0; k < (normals ? 6 : 3); ++k) {
             if (k > 0 && !in.next_token_in_line(token)) {
                 fail(Status::bad_format,
-                     concat("vertex ", i, " has ", k, " numbers; expected ", normals ? 6 : 3));
+                     concat("vertex ", i, " has ", counted(k, "number"), "; expected ", normals ? 6 : 3));
             }
             float value = 0;
             if (!parse_float(token, value)) {
@@ -110,7 +114,7 @@ Mesh read_off(std::string_view bytes, const std::string& name)
     std::vector<std::uint32_t> polygon;
     for (std::uint64_t i = 0; i < f; ++i) {
         if (!in.next_token(token)) {
-            fail(Status::truncated_file, concat("the file ends after ", i, " of ", f, " faces"));
+            fail(Status::truncated_file, concat("the file ends after ", i, " of ", counted(f, "face")));
         }
         std::int64_t n = 0;
         if (!parse_int(token, n)) {
@@ -119,7 +123,7 @@ Mesh read_off(std::string_view bytes, const std::string& name)
         }
         if (n < 3) {
             fail(Status::bad_format,
-                 concat("face ", i, " has ", n, " vertices; expected at least 3"));
+                 concat("face ", i, " has ", counted(n, "vertex", "vertices"), "; expected at least 3"));
         }
         polygon.clear();
         for (std::int64_t k = 0; k < n; ++k) {
@@ -134,7 +138,7 @@ Mesh read_off(std::string_view bytes, const std::string& name)
             }
             if (index < 0 || static_cast<std::uint64_t>(index) >= v) {
                 fail(Status::bad_format, concat("face ", i, " uses vertex index ", index,
-                                                " but the file has ", v, " vertices"));
+                                                " but the file has ", counted(v, "vertex", "vertices")));
             }
             polygon.push_back(static_cast<std::uint32_t>(index));
         }
@@ -145,8 +149,8 @@ Mesh read_off(std::string_view bytes, const std::string& name)
     }
     if (in.next_token(token)) {
         fail(Status::bad_format,
-             concat(quote_text(token), " follows the last of the ", f,
-                    " faces the counts declare; more data than declared (wrong counts?)"));
+             concat(quote_text(token), " follows the last of the ", counted(f, "face"),
+                    " the counts declare; more data than declared (wrong counts?)"));
     }
     return mesh;
 }

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mesh_formats.hpp"
+#include "plural.hpp"
 
 namespace cmc33::io::detail {
 namespace {
@@ -266,14 +267,15 @@ std::uint64_t assign_roles(Header& header, const std::string& name, bool& has_no
     return vertex->count;
 }
 
-// Least bytes (binary) or tokens (ascii) one record of `e` can take: a list can be empty, except
-// the face index list, which needs at least 3 items.
-std::uint64_t min_record_units(const Element& e, bool binary)
+// Bytes (binary) or tokens (ascii) one record of `e` takes with `face_items` items in its face
+// index list and none in other lists. With 0, the least a record can take: a face of 0 or 2
+// indices is then reported as such where it is read, not as a file too short for its counts.
+std::uint64_t min_record_units(const Element& e, bool binary, std::uint64_t face_items = 0)
 {
     std::uint64_t units = 0;
     for (std::size_t p = 0; p < e.properties.size(); ++p) {
         const Property& prop = e.properties[p];
-        const std::uint64_t items = e.roles[p] == Role::indices ? 3 : 0;
+        const std::uint64_t items = e.roles[p] == Role::indices ? face_items : 0;
         if (binary) {
             units += prop.list ? size_of(prop.count_type) + items * size_of(prop.type)
                                : size_of(prop.type);
@@ -315,19 +317,20 @@ struct Sink {
         }
     }
 
-    // Checks the polygon in `polygon` and fans it into triangles.
-    void end_face()
+    // Checks the polygon in `polygon` and fans it into triangles; `line` is its line in ASCII, 0 in binary.
+    void end_face(std::size_t line = 0)
     {
+        const auto fail = [&](const std::string& what) {
+            throw Error(Status::bad_format, concat(name, ": ", line > 0 ? concat("line ", line, ": ") : std::string(),
+                                                   "face ", face_number, " ", what));
+        };
         if (polygon.size() < 3) {
-            throw Error(Status::bad_format,
-                        concat(name, ": face ", face_number, " has ", polygon.size(),
-                               " vertex indices; expected at least 3"));
+            fail(concat("has ", counted(polygon.size(), "vertex index", "vertex indices"), "; expected at least 3"));
         }
         for (std::int64_t index : polygon) {
             if (index < 0 || static_cast<std::uint64_t>(index) >= vertex_count) {
-                throw Error(Status::bad_format,
-                            concat(name, ": face ", face_number, " uses vertex index ", index,
-                                   " but the file has ", vertex_count, " vertices"));
+                fail(concat("uses vertex index ", index, " but the file has ",
+                            counted(vertex_count, "vertex", "vertices")));
             }
         }
         for (std::size_t i = 1; i + 1 < polygon.size(); ++i) {
@@ -350,8 +353,9 @@ void check_count(const Element& e, std::uint64_t min_units, std::uint64_t capaci
                        remaining_bytes, " bytes remain"));
 }
 
-// Called once the element's count has been checked against the data.
-void allocate(const Element& e, Mesh& mesh, const std::string& name)
+// Called once the element's count has been checked against the data; at most `faces` faces are
+// reserved for (those the data holds room for as triangles), whatever the count declares.
+void allocate(const Element& e, Mesh& mesh, const std::string& name, std::uint64_t faces)
 {
     if (e.name == "vertex") {
         if (e.count > std::numeric_limits<std::uint32_t>::max()) {
@@ -364,7 +368,7 @@ void allocate(const Element& e, Mesh& mesh, const std::string& name)
             mesh.normals.assign(3 * static_cast<std::size_t>(e.count), 0.0f);
         }
     } else if (e.name == "face") {
-        mesh.triangles.reserve(3 * static_cast<std::size_t>(e.count));
+        mesh.triangles.reserve(3 * static_cast<std::size_t>(std::min(e.count, faces)));
     }
 }
 
@@ -453,7 +457,7 @@ void read_binary(const Header& header, std::string_view bytes, Sink& sink, const
         const std::uint64_t min_bytes = min_record_units(e, true);
         if (min_bytes == 0) continue; // no properties: records take no bytes
         check_count(e, min_bytes, in.remaining(), in.remaining(), "bytes", name);
-        allocate(e, sink.mesh, name);
+        allocate(e, sink.mesh, name, in.remaining() / min_record_units(e, true, 3));
         for (std::uint64_t r = 0; r < e.count; ++r) {
             for (std::size_t p = 0; p < e.properties.size(); ++p) {
                 const Property& prop = e.properties[p];
@@ -524,7 +528,7 @@ void read_ascii(const Header& header, std::string_view bytes, Sink& sink, const 
         if (min_tokens == 0) continue;
         // Each token takes at least one character and one separator.
         check_count(e, min_tokens, (in.remaining() + 1) / 2, in.remaining(), "numbers", name);
-        allocate(e, sink.mesh, name);
+        allocate(e, sink.mesh, name, (in.remaining() + 1) / 2 / min_record_units(e, false, 3));
         for (std::uint64_t r = 0; r < e.count; ++r) {
             for (std::size_t p = 0; p < e.properties.size(); ++p) {
                 const Property& prop = e.properties[p];
@@ -552,7 +556,7 @@ void read_ascii(const Header& header, std::string_view bytes, Sink& sink, const 
                     if (!parse_int(token, index)) bad_number(e, r, prop, "an integer index");
                     sink.polygon.push_back(index);
                 }
-                if (role == Role::indices) sink.end_face();
+                if (role == Role::indices) sink.end_face(header.lines + in.line());
             }
         }
     }
