@@ -16,6 +16,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/volume.hpp"
 #include "plane_reader.hpp"
+#include "plural.hpp"
 #include "slabs.hpp"
 #include "commands.hpp"
 #include "common.hpp"
@@ -230,13 +231,35 @@ std::vector<int> modes(const Histogram& h)
     return peaks;
 }
 
-/// A value for display and for --iso: integers for integer samples, 4 significant digits else.
-double round_for(double value, ScalarType type)
+/// Significant digits that tell apart values `step` apart within [lo, hi] (at least `least`):
+/// 1000 to 1000.009 in 16 bins needs 8, where 5 would print every edge as 1000.
+int digits_for(double lo, double hi, double step, int least)
 {
-    if (type != ScalarType::f32 && type != ScalarType::f64) return std::round(value);
-    // 4 digits can round past the largest double (1.797693e308 -> 1.798e308): keep the value then
-    const double rounded = std::strtod(sig(value, 4).c_str(), nullptr);
-    return std::isfinite(rounded) ? rounded : value;
+    const double magnitude = std::max(std::fabs(lo), std::fabs(hi));
+    if (!(magnitude > 0)) return least; // all zero
+    if (!(step > 0) || !std::isfinite(magnitude / step)) return 17; // a step below the values' ulp
+    const int needed = static_cast<int>(std::ceil(std::log10(magnitude / step))) + 1;
+    return std::clamp(needed, least, 17); // 17 digits name every double
+}
+
+/// A value for display and for --iso: an integer for integer samples, else the fewest significant
+/// digits (4 or more) that keep it within a thousandth of the range; either way inside (lo, hi],
+/// where an isovalue has samples on both sides (a sample equal to it counts as above).
+double round_for(double value, const Histogram& h, ScalarType type)
+{
+    const double lo = h.lo, hi = h.hi;
+    const auto inside = [&](double v) { return v > lo && v <= hi; };
+    if (type != ScalarType::f32 && type != ScalarType::f64) {
+        // lo and hi are integers here: the nearest integer above lo and at most hi
+        return std::clamp(std::round(value), lo + 1, hi);
+    }
+    const double tolerance = std::isfinite(hi - lo) ? (hi - lo) / 1000 : 0.5 * hi / 1000 - 0.5 * lo / 1000;
+    for (int digits = 4; digits <= 17; ++digits) {
+        const double rounded = std::strtod(sig(value, digits).c_str(), nullptr);
+        if (std::isfinite(rounded) && inside(rounded) && std::fabs(rounded - value) <= tolerance) return rounded;
+    }
+    if (inside(value)) return value;
+    return value <= lo ? std::nextafter(lo, hi) : hi; // a range of a few ulps: the nearest double inside
 }
 
 struct Candidate {
@@ -248,15 +271,16 @@ std::vector<Candidate> candidates(const Histogram& h, ScalarType type)
 {
     std::vector<Candidate> out;
     if (h.finite == 0 || !(h.hi > h.lo)) return out;
-    out.push_back({round_for(otsu(h), type), "Otsu's threshold"});
+    out.push_back({round_for(otsu(h), h, type), "Otsu's threshold"});
     std::vector<int> peaks = modes(h);
     if (peaks.size() > 3) peaks.resize(3);
     std::sort(peaks.begin(), peaks.end());
     auto centre = [&](int b) { return h.at(b + 0.5, kBins); };
+    const int digits = digits_for(h.lo, h.hi, h.at(1, kBins) - h.lo, 4);
     for (std::size_t i = 0; i + 1 < peaks.size(); ++i) {
         const double a = centre(peaks[i]), b = centre(peaks[i + 1]);
-        out.push_back({round_for(0.5 * a + 0.5 * b, type),
-                       "midway between the histogram modes near " + sig(a, 4) + " and " + sig(b, 4)});
+        out.push_back({round_for(0.5 * a + 0.5 * b, h, type),
+                       "midway between the histogram modes near " + sig(a, digits) + " and " + sig(b, digits)});
     }
     return out;
 }
@@ -293,6 +317,8 @@ void run_info(const InfoArgs& args)
     const std::vector<Candidate> cand = candidates(h, summary.type);
     const std::array<double, 5> qs{0.01, 0.25, 0.5, 0.75, 0.99};
     const bool has_values = h.finite > 0;
+    // equal samples fill one bin [lo, lo]: 16 empty bins [lo, lo) would say nothing
+    const int bin_count = !has_values ? 0 : hi > lo ? kBins : 1;
 
     if (args.json) {
         Json out = summary.volume;
@@ -302,9 +328,9 @@ void run_info(const InfoArgs& args)
         out["non_finite"] = {{"count", bad.count},
                              {"first", bad.count > 0 ? Json{bad.first[0], bad.first[1], bad.first[2]} : Json(nullptr)}};
         Json bins = Json::array();
-        for (int b = 0; b < kBins && has_values; ++b) {
+        for (int b = 0; b < bin_count; ++b) {
             bins.push_back({{"lo", h.at(b, kBins)},
-                            {"hi", b + 1 == kBins ? hi : h.at(b + 1, kBins)},
+                            {"hi", b + 1 == bin_count ? hi : h.at(b + 1, kBins)},
                             {"count", h.bins[static_cast<std::size_t>(b)]}});
         }
         out["histogram"] = bins;
@@ -318,7 +344,7 @@ void run_info(const InfoArgs& args)
         return;
     }
     std::cout << args.input << ": " << dims_text(summary.dims) << " " << type_name(summary.type) << " ("
-              << summary.samples << " samples, " << summary.bytes << " bytes)\n";
+              << counted(summary.samples, "sample") << ", " << counted(summary.bytes, "byte") << ")\n";
     std::cout << "spacing " << vec_text(summary.spacing) << ", origin " << vec_text(summary.origin) << '\n';
     print_frame(summary.space, summary.direction);
     if (!has_values) {
@@ -331,17 +357,28 @@ void run_info(const InfoArgs& args)
                   << ", " << bad.first[1] << ", " << bad.first[2] << "); extract refuses this volume\n";
     }
     if (!has_values) return;
-    std::cout << "histogram (" << kBins << " bins, bar length on a log scale):\n";
+    // as many digits as tell the bins' edges apart: 1000 to 1000.009 is not 16 bins [1000, 1000)
+    const int digits = digits_for(lo, hi, h.at(1, kBins) - lo, 5);
+    const std::size_t width = static_cast<std::size_t>(std::max(11, digits + 7));
+    if (bin_count == 1) {
+        std::cout << "histogram: every finite sample is " << num(lo) << '\n';
+    } else {
+        std::cout << "histogram (" << kBins << " bins, bar length on a log scale):\n";
+    }
     const std::int64_t largest = *std::max_element(h.bins.begin(), h.bins.end());
-    for (int b = 0; b < kBins; ++b) {
-        const double a = h.at(b, kBins), z = b + 1 == kBins ? hi : h.at(b + 1, kBins);
-        char line[160];
-        std::snprintf(line, sizeof line, "  [%11.5g, %11.5g%c %12lld  ", a, z, b + 1 == kBins ? ']' : ')',
-                      static_cast<long long>(h.bins[static_cast<std::size_t>(b)]));
-        std::cout << line << bar(h.bins[static_cast<std::size_t>(b)], largest) << '\n';
+    const auto edge = [&](double v) {
+        const std::string text = bin_count == 1 ? num(v) : sig(v, digits);
+        return std::string(text.size() < width ? width - text.size() : 0, ' ') + text;
+    };
+    for (int b = 0; b < bin_count; ++b) {
+        const double a = h.at(b, kBins), z = b + 1 == bin_count ? hi : h.at(b + 1, kBins);
+        char count[32];
+        std::snprintf(count, sizeof count, " %12lld  ", static_cast<long long>(h.bins[static_cast<std::size_t>(b)]));
+        std::cout << "  [" << edge(a) << ", " << edge(z) << (b + 1 == bin_count ? ']' : ')') << count
+                  << bar(h.bins[static_cast<std::size_t>(b)], largest) << '\n';
     }
     std::cout << "quantiles:";
-    for (double q : qs) std::cout << " p" << num(q * 100) << " " << sig(quantile(h, q), 5);
+    for (double q : qs) std::cout << " p" << num(q * 100) << " " << (bin_count == 1 ? num(lo) : sig(quantile(h, q), digits));
     std::cout << '\n';
     if (cand.empty()) {
         std::cout << "hint: every sample has the same value; there is no isosurface to extract\n";
