@@ -150,9 +150,15 @@ void add_extract(CLI::App& app)
     cmd->callback([args] {
         if (args->memory_limit.empty()) {
             run_extract(*args);
-        } else {
-            run_extract_slabs(*args);
+            return;
         }
+        // a usage conflict (exit 2) before any reading, not the passes' "use extract()" (exit 1)
+        if (parse_method(args->method) == Method::cmc33_paper) {
+            throw UsageError("--method cmc33-paper does not combine with --memory-limit: its refinement (Custodio et "
+                             "al. 2013, Sec. 6.2) inserts sample planes into the whole grid, which slabs cannot; run "
+                             "without --memory-limit, or with another method");
+        }
+        run_extract_slabs(*args);
     });
 }
 

@@ -6,6 +6,7 @@
 //   its temporary files (cli/signals.cpp).
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <new>
@@ -60,6 +61,48 @@ std::vector<std::string> arguments(int argc, char** argv)
     return args;
 }
 
+/// Whether `token` names an option of `cmd` (or of the whole tool): "--name", "--name=value",
+/// "-n" or "-nVALUE" (a short option with its value attached).
+bool known_option(const CLI::App& app, const CLI::App* cmd, const std::string& token)
+{
+    std::string name = token.substr(0, token.find('='));
+    if (name.size() > 2 && name[1] != '-') name.resize(2); // -nVALUE
+    for (const CLI::App* a : {cmd, &app}) {
+        if (a == nullptr) continue;
+        for (const CLI::Option* o : a->get_options()) {
+            if (o->check_name(name)) return true;
+        }
+    }
+    return false;
+}
+
+struct DashFile {
+    std::string command; ///< the subcommand given, or "COMMAND"
+    std::string file;    ///< empty: none
+};
+
+/// The first argument that starts with '-' but is neither an option nor a number, before any "--":
+/// a file named "-x.nrrd", which CLI11 takes for an unknown option (then reports "INPUT is required").
+DashFile dash_file(CLI::App& app, const std::vector<std::string>& args)
+{
+    const CLI::App* cmd = nullptr;
+    for (auto it = args.rbegin(); it != args.rend(); ++it) { // args are reversed
+        const std::string& a = *it;
+        if (a == "--") break;
+        if (cmd == nullptr && !a.empty() && a[0] != '-') {
+            for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) {
+                if (sub->get_name() == a) cmd = sub;
+            }
+        }
+        if (a.size() < 2 || a[0] != '-') continue;
+        char* end = nullptr;
+        (void)std::strtod(a.c_str(), &end);
+        if (end != nullptr && *end == '\0') continue; // a negative number, a value
+        if (!known_option(app, cmd, a)) return {cmd ? cmd->get_name() : "COMMAND", a};
+    }
+    return {};
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -92,6 +135,7 @@ int main(int argc, char** argv)
             }
             if (!found) return usage("unknown command '" + args.back() + "'; the commands are " + known);
         }
+        const std::vector<std::string> given = args; // parse() consumes args
         try {
             app.parse(args);
         } catch (const CLI::CallForHelp& e) {
@@ -101,6 +145,12 @@ int main(int argc, char** argv)
         } catch (const CLI::CallForVersion& e) {
             return app.exit(e);
         } catch (const CLI::ParseError& e) {
+            const DashFile dash = dash_file(app, given);
+            if (!dash.file.empty() && (dynamic_cast<const CLI::RequiredError*>(&e) || dynamic_cast<const CLI::ExtrasError*>(&e))) {
+                return usage(dash.file + " is not an option of cmc33 " + dash.command + "; if it is a file, put it after " +
+                             "\"--\", the options before it (cmc33 " + dash.command + " [OPTIONS] -- " + dash.file +
+                             "), or write it ./" + dash.file);
+            }
             return usage(e.what());
         }
         std::cout.flush();

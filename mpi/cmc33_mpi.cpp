@@ -268,6 +268,11 @@ void run_extract(const World& w, const ExtractArgs& args)
                                   args.output);
         }
         options.extract.method = parse_method(args.method);
+        if (options.extract.method == Method::cmc33_paper) { // a usage conflict (exit 2), not the passes' "use extract()"
+            throw cli::UsageError("--method cmc33-paper does not run over ranks: its refinement (Custodio et al. 2013, "
+                                  "Sec. 6.2) inserts sample planes into the whole grid, which slabs cannot; run `cmc33 "
+                                  "extract` without --memory-limit, or another method");
+        }
         options.extract.normals = args.normals;
         options.extract.threads = args.threads;
         options.memory_limit = args.memory_limit.empty() ? 0 : slabs::parse_size(args.memory_limit);

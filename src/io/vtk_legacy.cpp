@@ -291,7 +291,8 @@ Volume read_vtk(const ByteInput& file, const ReadSamples& read)
     ByteSource& source = lines.source();
     std::string_view rest = source.rest();
     const std::size_t word = binary ? 0 : std::min(rest.find_first_not_of(" \t\r\n"), rest.size());
-    if (rest.substr(word, 12) == "LOOKUP_TABLE") {
+    // VTK matches its keywords in any case: "lookup_table default" is a lookup table, not samples
+    if (equals_ignore_case(rest.substr(word, 12), "LOOKUP_TABLE")) {
         std::string_view skipped;
         source.take(word, skipped);
         lines.line("LOOKUP_TABLE name");

@@ -305,8 +305,9 @@ CommandResult run_command(const ExternalCommand& command, const std::filesystem:
 {
     std::error_code ec;
     std::filesystem::remove(command.output, ec);
+    // the newline ends a `#` comment the template may hold, which would otherwise swallow the ")"
     const std::string line =
-        "(" + command.shell + ") >" + shell_quote(log.string()) + " 2>&1 </dev/null";
+        "(" + command.shell + "\n) >" + shell_quote(log.string()) + " 2>&1 </dev/null";
     bool timed_out = false;
     const int status = run_shell(line, timeout_seconds, timed_out);
     CommandResult result;
