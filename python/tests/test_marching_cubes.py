@@ -298,3 +298,40 @@ def test_bad_volumes_are_value_errors():
     with pytest.raises(cmc33.NonFiniteError) as error:
         cmc33.marching_cubes(volume, 0.5)
     assert isinstance(error.value, ValueError) and "NaN" in str(error.value)
+
+
+def test_non_finite_samples_are_named_as_the_caller_indexes_them():
+    volume = ellipsoid()
+    volume[3, 4, 5] = np.nan
+    volume[6, 1, 2] = -np.inf
+    for layout in (volume, np.asfortranarray(volume), volume.astype(np.float32)):
+        with pytest.raises(cmc33.NonFiniteError, match=r"^2 samples are NaN or infinite, the first at volume\[3, 4, 5\];"):
+            cmc33.marching_cubes(layout, 0.5)
+    # step_size reads every other sample: [3, 4, 5] is skipped, [6, 1, 2] is not read either, [8, 2, 0] is
+    volume[8, 2, 0] = np.nan
+    with pytest.raises(cmc33.NonFiniteError, match=r"^1 sample is NaN or infinite, the first at volume\[8, 2, 0\];"):
+        cmc33.marching_cubes(volume, 0.5, step_size=2)
+    # a view with negative strides: the index is the view's, as the caller wrote it
+    flipped = volume[::-1]
+    with pytest.raises(cmc33.NonFiniteError, match=r"the first at volume\[21, 2, 0\];"):
+        cmc33.marching_cubes(flipped, 0.5)
+
+
+def test_lorensen_private_name_is_refused_not_answered_with_four_arrays():
+    with pytest.raises(ValueError, match=r"'_lorensen' is scikit-image's private .* use method='lorensen'"):
+        cmc33.marching_cubes(ellipsoid(), 0.5, method="_lorensen")
+
+
+def test_every_method_scikit_image_has_returns_its_number_of_arrays(skimage_mc):
+    volume = ellipsoid()
+    for method in ("lewiner", "lorensen", "_lorensen"):
+        try:
+            theirs = skimage_mc(volume, 10.0, method=method)
+        except ValueError:
+            continue  # not a method of the installed scikit-image
+        try:
+            ours = cmc33.marching_cubes(volume, 10.0, method=method)
+        except ValueError as e:
+            assert "private" in str(e), (method, e)  # refused by name, never a different shape
+            continue
+        assert len(ours) == len(theirs), method

@@ -313,3 +313,18 @@ def test_every_public_name_is_documented():
     assert len(inspect.getdoc(cmc33.marching_cubes)) > 2000
     package = Path(cmc33.__file__).parent
     assert (package / "_cmc33.pyi").is_file() and (package / "py.typed").is_file()
+
+
+def test_non_finite_samples_are_named_as_numpy_indexes_them():
+    volume = ellipsoid()
+    volume[7, 2, 9] = np.nan
+    with pytest.raises(cmc33.NonFiniteError, match=r"^1 sample is NaN or infinite, the first at volume\[7, 2, 9\];"):
+        cmc33.extract(volume, 10.0)
+    with pytest.raises(cmc33.NonFiniteError, match=r"the first at volume\[7, 2, 9\];"):
+        cmc33.field_topology(volume, 10.0)
+    wrapped = cmc33.Volume(volume, (1, 1, 1), (0, 0, 0), ((1, 0, 0), (0, 1, 0), (0, 0, 1)))
+    with pytest.raises(cmc33.NonFiniteError, match=r"the first at volume.samples\[7, 2, 9\];"):
+        cmc33.extract(wrapped, 10.0)
+    # an error about something else keeps its own message
+    with pytest.raises(cmc33.NonFiniteError, match="isovalue"):
+        cmc33.extract(ellipsoid(), float("inf"))

@@ -8,9 +8,10 @@ from typing import Any, Callable, Optional, Sequence, Tuple, Union
 import numpy as np
 
 from . import _cmc33
-from ._arrays import IDENTITY, as_samples, mat3, method_name, thread_count, vec3
+from ._arrays import IDENTITY, as_samples, mat3, method_name, raise_non_finite, thread_count, vec3
 from ._cmc33 import (CellReport, FieldTopology, Mesh, MeshGeometry, MeshTopology, VerifyReport,
                      Volume)
+from ._errors import NonFiniteError
 
 PathLike = Union[str, "os.PathLike[str]"]
 #: A Mesh, or arrays (vertices, triangles[, normals, ...]) such as marching_cubes returns.
@@ -92,14 +93,17 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
     ------
     ValueError
         A volume that is not 3D or has fewer than 2 samples on an axis, bad arguments,
-        NaN or infinite samples (NonFiniteError names how many and the first).
+        NaN or infinite samples (NonFiniteError names how many and the first as you index it,
+        ``volume[z, y, x]``).
     KeyboardInterrupt
         Ctrl-C stops the extraction within a fraction of a second.
 
     The GIL is released while the library works.
     """
+    name = "volume"
     if isinstance(volume, Volume):
         samples = volume.samples
+        name = "volume.samples"
         spacing = volume.spacing if spacing is None else spacing
         origin = volume.origin if origin is None else origin
         direction = volume.direction if direction is None else direction
@@ -107,10 +111,14 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         samples = as_samples(volume)
     if progress is not None and not callable(progress):
         raise ValueError(f"progress {progress!r} is not callable")
-    return _cmc33.extract(samples, float(iso), vec3((1, 1, 1) if spacing is None else spacing, "spacing"),
-                          vec3((0, 0, 0) if origin is None else origin, "origin"),
-                          IDENTITY if direction is None else mat3(direction), _method(method), bool(normals),
-                          thread_count(threads), progress)
+    try:
+        return _cmc33.extract(samples, float(iso), vec3((1, 1, 1) if spacing is None else spacing, "spacing"),
+                              vec3((0, 0, 0) if origin is None else origin, "origin"),
+                              IDENTITY if direction is None else mat3(direction), _method(method), bool(normals),
+                              thread_count(threads), progress)
+    except NonFiniteError:
+        raise_non_finite(samples, name)  # names volume[z, y, x], not the library's (x, y, z)
+        raise
 
 
 def read_volume(path: PathLike, *, dims: Optional[Sequence[int]] = None, dtype: Any = None,
@@ -202,7 +210,11 @@ def field_topology(volume: Union[Volume, Any], iso: float, *, max_refinement: in
     compare with mesh_topology(). ``volume`` as in extract() (read in place); the frame does not
     matter. The GIL is released; this call cannot be interrupted."""
     samples = volume.samples if isinstance(volume, Volume) else as_samples(volume)
-    return _cmc33.field_topology(samples, float(iso), int(max_refinement))
+    try:
+        return _cmc33.field_topology(samples, float(iso), int(max_refinement))
+    except NonFiniteError:
+        raise_non_finite(samples, "volume.samples" if isinstance(volume, Volume) else "volume")
+        raise
 
 
 def analyze_cell(values: Sequence[float], iso: float = 0.0, *, method: str = "cmc33") -> CellReport:

@@ -7,6 +7,8 @@ from typing import Any, Sequence, Tuple
 
 import numpy as np
 
+from ._errors import NonFiniteError
+
 Vec3 = Tuple[float, float, float]
 Mat3 = Tuple[Vec3, Vec3, Vec3]
 
@@ -82,3 +84,21 @@ def method_name(method: str, accepted: Sequence[str]) -> str:
     if method not in accepted:
         raise ValueError(f"method {method!r}; expected one of {', '.join(repr(m) for m in accepted)}")
     return method
+
+
+def raise_non_finite(samples: np.ndarray, name: str, step: int = 1) -> None:
+    """Raises NonFiniteError counting the NaN and infinite samples the library read (every
+    ``step``-th along each axis) and naming the first (C order) as the caller indexes the array,
+    ``name[z, y, x]``; returns if there is none (the library's error was about something else).
+    The library's own message gives (x, y, z), its axis order, which a numpy user would misread."""
+    if samples.dtype.kind != "f":
+        return
+    read = samples[::step, ::step, ::step] if step > 1 else samples
+    bad = ~np.isfinite(read)
+    count = int(np.count_nonzero(bad))
+    if count == 0:
+        return
+    first = [int(i) * step for i in np.unravel_index(int(np.argmax(bad)), bad.shape)]
+    noun = "sample is" if count == 1 else "samples are"
+    raise NonFiniteError(f"{count} {noun} NaN or infinite, the first at {name}[{first[0]}, {first[1]}, {first[2]}]; "
+                         "cmc33 needs finite samples")

@@ -8,7 +8,8 @@ from typing import Any, Optional, Sequence, Tuple
 import numpy as np
 
 from . import _cmc33
-from ._arrays import as_samples, thread_count, vec3
+from ._arrays import as_samples, raise_non_finite, thread_count, vec3
+from ._errors import NonFiniteError
 
 # scikit-image's method names and cmc33's own, to the method that runs.
 _METHODS = {
@@ -17,7 +18,6 @@ _METHODS = {
     "mc33-lewiner": "mc33-lewiner",
     "mc": "mc",
     "lorensen": "mc",
-    "_lorensen": "mc",
 }
 
 
@@ -69,7 +69,8 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
         'cmc33' (default), and scikit-image's 'lewiner', which runs 'cmc33' too (the same
         algorithm with the corrections); 'lorensen' runs classic Marching Cubes ('mc'), also
         embedded but without the topological guarantees. 'mc33-lewiner' reproduces the flaws of
-        the 2003 MC33 for comparison.
+        the 2003 MC33 for comparison. scikit-image's private '_lorensen', which returns only
+        (verts, faces), is refused (ValueError) rather than answered with four arrays.
     mask : (M, N, P) bool array, optional
         Keep only the cells where the mask is True at the cell's corner of largest index (this is
         what scikit-image's implementation reads), giving an open surface that ends at the masked
@@ -95,7 +96,8 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
     ValueError
         A volume that is not 3D or smaller than 2x2x2, ``level`` outside the data range, a bad
         ``spacing``, ``step_size``, ``gradient_direction``, ``method`` or mask shape, NaN or
-        infinite samples (cmc33.NonFiniteError, a ValueError).
+        infinite samples (cmc33.NonFiniteError, a ValueError, naming the first as ``volume[i, j, k]``
+        in your array's axis order).
     RuntimeError
         No surface at ``level``, as scikit-image.
     KeyboardInterrupt
@@ -138,6 +140,10 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
         raise ValueError(f"step_size {step}; expected at least one")
     if gradient_direction not in ("descent", "ascent"):
         raise ValueError(f"gradient_direction {gradient_direction!r}; expected 'descent' or 'ascent'")
+    if method == "_lorensen":
+        # scikit-image's private name returns (verts, faces) only: the 4-tuple here would break its callers' unpacking
+        raise ValueError("method '_lorensen' is scikit-image's private classic Marching Cubes, which returns "
+                         "(verts, faces) only; use method='lorensen' (classic Marching Cubes, the four arrays)")
     if method not in _METHODS:
         raise ValueError(f"method {method!r}; expected one of {', '.join(repr(m) for m in _METHODS)}")
     threads = thread_count(threads)
@@ -167,9 +173,13 @@ def marching_cubes(volume: Any, level: Optional[float] = None, *, spacing: Seque
         _check_level(samples, level, threads)
         raise RuntimeError(f"No surface found at the given iso value: step_size {step} leaves the grid "
                            f"{grid.shape}, with fewer than 2 samples along an axis")
-    verts, faces, normals, values = _cmc33.marching_cubes(
-        grid, level, tuple(s * step for s in spacing), _METHODS[method], gradient_direction == "descent",
-        mask_cells, threads, None)
+    try:
+        verts, faces, normals, values = _cmc33.marching_cubes(
+            grid, level, tuple(s * step for s in spacing), _METHODS[method], gradient_direction == "descent",
+            mask_cells, threads, None)
+    except NonFiniteError:
+        raise_non_finite(samples, "volume", step)  # names volume[z, y, x], not the library's (x, y, z)
+        raise
     if len(faces) == 0:
         _check_level(samples, level, threads)
         raise RuntimeError(f"No surface found at the given iso value: level {level:g}")
