@@ -4,10 +4,12 @@
 #include <chrono>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/io.hpp"
@@ -27,6 +29,27 @@ double median(std::vector<double> values)
     return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
+/// Whether the mesh is extracted with the origin at 0 and written as origin + position in double
+/// precision: --positions double, or auto where 32-bit floats cannot keep it embedded in world space.
+bool double_positions(const ExtractArgs& args, const Volume& volume)
+{
+    const bool stl = !args.output.empty() && io::detail::lower_extension(args.output) == ".stl";
+    if (args.positions == "double") {
+        if (stl) throw UsageError("--positions double does not combine with STL output (32-bit floats only): " + args.output);
+        return true;
+    }
+    const double steps = float_steps_per_cell(volume.dims(), volume.spacing(), volume.origin(), volume.direction());
+    if (args.positions == "float" || steps >= kMinFloatStepsPerCell) return false;
+    if (stl) {
+        throw Error(Status::too_large,
+                    args.input + ": the volume lies so far from the origin that 32-bit floats resolve only " + sig(steps, 3) +
+                        " steps across a cell (at least " + num(kMinFloatStepsPerCell) +
+                        " keep the mesh embedded), and STL stores 32-bit floats; write .ply, .obj or .off "
+                        "(double-precision positions), or move the volume's origin nearer 0");
+    }
+    return true;
+}
+
 void run_extract(const ExtractArgs& args)
 {
     ExtractOptions options;
@@ -36,7 +59,14 @@ void run_extract(const ExtractArgs& args)
     // A bad -o must fail before minutes of work, not after.
     check_mesh_output(args.output, args.ascii, args.normals, {args.input});
 
-    const Volume volume = load_volume(args.input, args.raw);
+    Volume volume = load_volume(args.input, args.raw);
+    // Far from the origin the mesh is made at the origin and moved back in double precision when
+    // written: floats near 0 keep it embedded, and adding the origin in double is exact.
+    std::optional<Vec3> offset;
+    if (double_positions(args, volume)) {
+        offset = volume.origin();
+        volume.set_origin({0, 0, 0});
+    }
 
     Mesh mesh;
     ExtractStats stats;
@@ -72,8 +102,9 @@ void run_extract(const ExtractArgs& args)
     }
     if (!args.output.empty()) {
         named_step(args.output, "writing the mesh",
-                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii}); });
+                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii, offset}); });
     }
+    if (offset) volume.set_origin(*offset);
 
     ExtractReport report;
     report.volume = volume_json(args.input, volume);
@@ -88,6 +119,7 @@ void run_extract(const ExtractArgs& args)
     report.topology = topology;
     report.geometry = geometry;
     report.stats = stats;
+    report.extra["positions"] = offset ? "double" : "float";
     print_extract_report(args, report);
 }
 
@@ -124,6 +156,11 @@ void add_extract(CLI::App& app)
                                    "Progress lines on stderr even when it is not a terminal");
     cmd->add_flag("--quiet", args->quiet, "No progress line (shown on a terminal when extraction takes over a second)")
         ->excludes(progress);
+    cmd->add_option("--positions", args->positions,
+                    "auto (default): 32-bit float positions, or double where floats cannot keep the mesh embedded "
+                    "far from the origin; float: always (refused where they cannot); double: always (.ply .obj .off)")
+        ->type_name("PRECISION")
+        ->check(CLI::IsMember({"auto", "float", "double"}));
     cmd->add_option("--memory-limit", args->memory_limit,
                     "Read the volume and write the mesh slab by slab within SIZE bytes (256M, 2G): for "
                     "volumes and meshes larger than memory; binary .ply only, same bytes")

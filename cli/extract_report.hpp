@@ -26,6 +26,7 @@ struct ExtractArgs {
     bool progress = false;
     bool quiet = false;
     std::string memory_limit; ///< empty: the volume and the mesh in memory
+    std::string positions = "auto"; ///< auto, float or double (--positions)
     RawVolumeOptions raw;
 };
 

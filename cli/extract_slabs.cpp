@@ -13,6 +13,7 @@
 
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "extract_report.hpp"
@@ -86,6 +87,19 @@ void run_extract_slabs(const ExtractArgs& args)
     const io::detail::VolumeLayout layout =
         named_step(args.input, "reading the volume's header", [&] { return io::detail::describe_volume(args.input, raw); });
     const io::detail::Grid& grid = layout.grid;
+    // The slabs' records are 32-bit float positions at fixed offsets; a volume far from the origin
+    // needs the in-memory run, which writes doubles (--positions).
+    if (args.positions == "double") {
+        throw UsageError("--positions double does not combine with --memory-limit (its records hold 32-bit floats)");
+    }
+    if (const double steps = float_steps_per_cell(grid.dims, grid.spacing, grid.origin, grid.direction);
+        args.positions == "auto" && steps < kMinFloatStepsPerCell) {
+        throw Error(Status::too_large,
+                    args.input + ": the volume lies so far from the origin that 32-bit floats resolve only " +
+                        sig(steps, 3) + " steps across a cell (at least " + num(kMinFloatStepsPerCell) +
+                        " keep the mesh embedded); --memory-limit writes 32-bit floats: run without it "
+                        "(double-precision positions), or move the volume's origin nearer 0");
+    }
 
     const auto start = std::chrono::steady_clock::now();
     const Progress progress = fraction_line(args.progress, args.quiet, "extracting the mesh slab by slab");

@@ -219,20 +219,35 @@ std::vector<Word> valid_words(std::int64_t words, std::int64_t bits)
 
 constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
 
-/// The largest |world coordinate| over the 8 corners of the grid's box (every vertex lies in it).
-template <class T> double largest_coordinate(const GridView<T>& g)
+/// The largest |world coordinate| over the 8 corners of the box of a grid of `dims` samples in the
+/// frame (origin, M) (every vertex lies in it).
+double largest_coordinate(const Index3& dims, const Vec3& origin, const Mat3& m)
 {
-    const Mat3 m = frame_matrix(g.spacing, g.direction);
     double largest = 0;
     for (int corner = 0; corner < 8; ++corner) {
         double x[3];
-        for (std::size_t a = 0; a < 3; ++a) x[a] = (corner >> a) & 1 ? static_cast<double>(g.dims[a] - 1) : 0.0;
+        for (std::size_t a = 0; a < 3; ++a) x[a] = (corner >> a) & 1 ? static_cast<double>(dims[a] - 1) : 0.0;
         for (std::size_t r = 0; r < 3; ++r) {
-            const double w = g.origin[r] + (m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2]);
+            const double w = origin[r] + (m[r][0] * x[0] + m[r][1] * x[1] + m[r][2] * x[2]);
             largest = std::max(largest, std::fabs(w));
         }
     }
     return largest;
+}
+template <class T> double largest_coordinate(const GridView<T>& g)
+{
+    return largest_coordinate(g.dims, g.origin, frame_matrix(g.spacing, g.direction));
+}
+
+/// The shortest cell edge in world units: the length of M's shortest column.
+double shortest_edge(const Mat3& m)
+{
+    double shortest = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < 3; ++a) {
+        const double length = is_diagonal(m) ? std::fabs(m[a][a]) : std::hypot(m[0][a], m[1][a], m[2][a]);
+        shortest = std::min(shortest, length);
+    }
+    return shortest;
 }
 
 /// The largest |sample| of planes [k_lo, k_hi] (for integer types, the type's bound).
@@ -1012,11 +1027,7 @@ private:
     static double min_crossing(const GridView<T>& g, const Mat3& m)
     {
         const double largest = largest_coordinate(g);
-        double shortest = std::numeric_limits<double>::infinity();
-        for (std::size_t a = 0; a < 3; ++a) {
-            const double length = is_diagonal(m) ? std::fabs(m[a][a]) : std::hypot(m[0][a], m[1][a], m[2][a]);
-            shortest = std::min(shortest, length);
-        }
+        const double shortest = shortest_edge(m);
         if (!(largest > 0) || !(shortest > 0) || !std::isfinite(largest)) return detail::kMinCrossing;
         const double ulp = std::ldexp(1.0, std::ilogb(largest) - 23);
         return std::clamp(16 * ulp / shortest, detail::kMinCrossing, 0.125);
@@ -1228,7 +1239,11 @@ private:
         const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
         const bool zyx = kOut == Outputs::drop_in || (kOut == Outputs::all && out.zyx);
         write_position(x, &out.positions[v * 3], zyx);
-        if (out.normals) write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx);
+        if (out.normals && !write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx)) {
+            // central differences cancel (alternating samples): the interpolant's own gradient,
+            // never 0 on a crossed edge
+            write_normal(&out.normals[v * 3], edge_cell_gradient(i, j, k, axis, t, e.gradient_scale), zyx);
+        }
         if constexpr (kOut != Outputs::plain) {
             if (kOut == Outputs::drop_in || out.vertex_cell_ranges) {
                 // x and y edges of the range's first plane: the cells below are the previous range's
@@ -1247,7 +1262,8 @@ private:
     }
 
     /// Normals point from above to below: along minus the world gradient. `zyx` as in write_position.
-    CMC33_ALWAYS_INLINE void write_normal(float* out, std::array<double, 3> g, bool zyx) const
+    /// False (and (0, 0, 0) written) where g is 0: the caller then falls back to another gradient.
+    CMC33_ALWAYS_INLINE bool write_normal(float* out, std::array<double, 3> g, bool zyx) const
     {
         if (!diagonal_) {
             const Mat3& n = normal_map_;
@@ -1264,13 +1280,39 @@ private:
             }
         }
         if (!(len > 0)) {
-            out[0] = out[1] = out[2] = 0.0f; // a flat field: no direction
-            return;
+            out[0] = out[1] = out[2] = 0.0f; // no direction here: the caller falls back
+            return false;
         }
         const double minus_inverse = -1 / len; // one divide, then multiplies
         float n[3];
         for (std::size_t c = 0; c < 3; ++c) n[c] = static_cast<float>(g[c] * minus_inverse);
         store(n, out, zyx);
+        return true;
+    }
+
+    /// The gradient of the trilinear interpolant at parameter t of the edge from sample (i, j, k)
+    /// along `axis`, in the cell on the edge's upper side of each other axis (the lower side at the
+    /// grid's last sample), scaled as gradient(). Its `axis` component is b - a: never 0 on a
+    /// crossed edge, so a normal always has a direction.
+    std::array<double, 3> edge_cell_gradient(std::int64_t i, std::int64_t j, std::int64_t k, int axis, double t,
+                                             double scale) const
+    {
+        const std::int64_t idx[3] = {i, j, k}, n[3] = {nx_, ny_, nz_};
+        const T* p = g_.data + g_.offset(i, j, k);
+        const T* q = p + g_.strides[static_cast<std::size_t>(axis)];
+        std::array<double, 3> grad{};
+        for (std::size_t c = 0; c < 3; ++c) {
+            const double inverse = 2 * half_inverse_step_[c];
+            if (static_cast<int>(c) == axis) {
+                grad[c] = difference(*q, *p, scale) * inverse;
+                continue;
+            }
+            const std::int64_t st = idx[c] + 1 < n[c] ? g_.strides[c] : -g_.strides[c];
+            const double sign = st > 0 ? 1.0 : -1.0;
+            const double da = difference(p[st], p[0], scale), db = difference(q[st], q[0], scale);
+            grad[c] = sign * (da + t * (db - da)) * inverse;
+        }
+        return grad;
     }
 
     /// The cells of cell row (j, k) (its span `r`, its four rows of flags as emit_planes found
@@ -1380,6 +1422,68 @@ private:
         return tl->triangle_count;
     }
 
+    /// The gradient of the cell's trilinear interpolant (corner samples `value`) at unit point p,
+    /// scaled as gradient().
+    std::array<double, 3> cell_gradient(const T (&value)[8], const double (&p)[3], double scale) const
+    {
+        std::array<double, 3> grad{};
+        for (std::size_t a = 0; a < 3; ++a) {
+            double sum = 0;
+            for (int c = 0; c < 8; ++c) {
+                if ((c >> a) & 1) continue; // each pair of corners along axis a once
+                const int d = c | (1 << a);
+                double w = 1; // the pair's weight: the other two axes' linear factors
+                for (std::size_t b = 0; b < 3; ++b) {
+                    if (b != a) w *= ((c >> b) & 1) ? p[b] : 1 - p[b];
+                }
+                sum += w * difference(value[d], value[c], scale);
+            }
+            grad[a] = sum * 2 * half_inverse_step_[a];
+        }
+        return grad;
+    }
+
+    /// Minus the area-weighted normal of the tiling's triangles around its interior vertex q (unit
+    /// point pq), as a gradient for write_normal(): where the interpolant itself is flat there (a
+    /// critical point), the surface still has a side. Triangles wind with their normals toward the
+    /// below side (mc33_tables.hpp), in index space; M^-T takes them to world space as it does
+    /// gradients.
+    std::array<double, 3> fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3]) const
+    {
+        double crossings[12][3]; // the crossed edges' points (interior_position reads only those)
+        for (int edge = 0; edge < 12; ++edge) {
+            const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
+            const bool crossed = (static_cast<double>(value[a]) >= iso_) != (static_cast<double>(value[b]) >= iso_);
+            const double t = crossed ? crossing(value[a], value[b]) : 0.5;
+            for (int c = 0; c < 3; ++c) crossings[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
+        }
+        const auto point = [&](int code, double (&x)[3]) {
+            if (code == 12 + q) {
+                for (int c = 0; c < 3; ++c) x[c] = pq[c];
+            } else if (code < 12) {
+                for (int c = 0; c < 3; ++c) x[c] = crossings[code][c];
+            } else {
+                detail::interior_position(detail::kInteriorMasks[tl.first_interior + (code - 12)], crossings, x);
+            }
+        };
+        const std::uint8_t* codes = &detail::kTriangleCodes[static_cast<std::size_t>(tl.first_triangle) * 3];
+        std::array<double, 3> sum{};
+        for (int f = 0; f < tl.triangle_count; ++f) {
+            const std::uint8_t* t = codes + 3 * f;
+            if (t[0] != 12 + q && t[1] != 12 + q && t[2] != 12 + q) continue;
+            double a[3], b[3], c[3];
+            point(t[0], a);
+            point(t[1], b);
+            point(t[2], c);
+            const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            sum[0] += u[1] * w[2] - u[2] * w[1];
+            sum[1] += u[2] * w[0] - u[0] * w[2];
+            sum[2] += u[0] * w[1] - u[1] * w[0];
+        }
+        for (std::size_t a = 0; a < 3; ++a) sum[a] *= -2 * half_inverse_step_[a];
+        return sum;
+    }
+
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
     /// placement.hpp from the cell's crossings; normals interpolate the corners' gradients.
     void write_interior_vertices(std::int64_t i, std::int64_t j, std::int64_t k, const detail::Tiling& tl,
@@ -1435,7 +1539,10 @@ private:
                 std::array<double, 3> n{};
                 for (int c = 0; c < 8; ++c)
                     for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
-                write_normal(&out.normals[v * 3], n, out.zyx);
+                if (!write_normal(&out.normals[v * 3], n, out.zyx) &&
+                    !write_normal(&out.normals[v * 3], cell_gradient(value, p, e.gradient_scale), out.zyx)) {
+                    write_normal(&out.normals[v * 3], fan_gradient(value, tl, q, p), out.zyx);
+                }
             }
             if (out.vertex_edges) out.vertex_edges[v] = -1 - (i + nx_ * (j + ny_ * k));
             if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
@@ -1507,6 +1614,15 @@ template <class T> void check_grid(const GridView<T>& g, double iso)
         std::snprintf(text, sizeof text, "world coordinates up to %.4g do not fit the output's 32-bit floats "
                                          "(at most %.4g); scale the spacing or origin down", largest,
                       static_cast<double>(std::numeric_limits<float>::max()));
+        throw Error(Status::too_large, text);
+    }
+    if (const double steps = float_steps_per_cell(g.dims, g.spacing, g.origin, g.direction); steps < kMinFloatStepsPerCell) {
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "world coordinates up to %.6g leave 32-bit floats %.3g steps across a cell, too few to keep the "
+                      "mesh embedded (at least %g needed); move the origin nearer 0, or write double-precision "
+                      "positions (cmc33 extract --positions double)",
+                      largest, steps, kMinFloatStepsPerCell);
         throw Error(Status::too_large, text);
     }
     // a row's vertex count (3 nx edge vertices + at most 12 interior ones per cell) is kept in 32
@@ -1680,6 +1796,33 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
             }
     }
     return mesh;
+}
+
+double float_steps_per_cell(const Index3& dims, const Vec3& spacing, const Vec3& origin, const Mat3& direction)
+{
+    const Mat3 m = frame_matrix(spacing, direction);
+    // ulp[r]: the float spacing of world component r at its largest |value| over the box
+    double ulp[3] = {0, 0, 0};
+    for (std::size_t r = 0; r < 3; ++r) {
+        double largest = 0;
+        for (int corner = 0; corner < 8; ++corner) {
+            double w = origin[r];
+            for (std::size_t a = 0; a < 3; ++a) w += (corner >> a) & 1 ? m[r][a] * static_cast<double>(dims[a] - 1) : 0.0;
+            largest = std::max(largest, std::fabs(w));
+        }
+        if (!std::isfinite(largest)) return 0;
+        if (largest > 0) ulp[r] = std::ldexp(1.0, std::ilogb(largest) - 23);
+    }
+    // rounding component r moves a point by up to ulp[r]; M^-1 says how far that is in cells
+    const Mat3 inverse_t = inverse_transpose(m); // inverse_t[r][a] = M^-1[a][r]
+    double steps = std::numeric_limits<double>::infinity();
+    for (std::size_t a = 0; a < 3; ++a) {
+        double cells = 0;
+        for (std::size_t r = 0; r < 3; ++r) cells += std::fabs(inverse_t[r][a]) * ulp[r];
+        if (!std::isfinite(cells)) return 0;
+        if (cells > 0) steps = std::min(steps, 1 / cells);
+    }
+    return steps;
 }
 
 Mesh extract(const Volume& volume, double iso, const ExtractOptions& options, ExtractStats* stats)

@@ -27,19 +27,26 @@ Mesh read_obj(std::string_view bytes, const std::string& name);
 Mesh read_stl(std::string_view bytes, const std::string& name);
 Mesh read_off(std::string_view bytes, const std::string& name);
 
-void write_ply(const Mesh& mesh, std::ostream& out, bool ascii);
+// `offset` (3 doubles) or null: positions are written in double precision as offset + position
+// (a mesh extracted with its origin at 0, where 32-bit floats cannot keep it embedded in world space).
+void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* offset = nullptr);
 /// The header write_ply writes for a mesh of these sizes. A binary file continues with
 /// kPlyVertexBytes (kPlyNormalVertexBytes with normals) per vertex, then kPlyFaceBytes per
 /// triangle, so a writer that knows the sizes can place any slice of the mesh (out-of-core slabs,
 /// MPI ranks: src/slabs) at its offset.
-CMC33_IO_EXPORT std::string ply_header(std::uint64_t vertices, std::uint64_t triangles, bool normals, bool ascii);
+CMC33_IO_EXPORT std::string ply_header(std::uint64_t vertices, std::uint64_t triangles, bool normals, bool ascii,
+                                       bool double_positions = false);
 inline constexpr std::size_t kPlyVertexBytes = 12;       ///< float x y z
 inline constexpr std::size_t kPlyNormalVertexBytes = 24; ///< float x y z nx ny nz
 inline constexpr std::size_t kPlyFaceBytes = 13;         ///< uchar 3, uint a b c
-void write_obj(const Mesh& mesh, std::ostream& out);
+void write_obj(const Mesh& mesh, std::ostream& out, const double* offset = nullptr);
 void write_stl(const Mesh& mesh, std::ostream& out);
-void write_off(const Mesh& mesh, std::ostream& out);
+void write_off(const Mesh& mesh, std::ostream& out, const double* offset = nullptr);
 
+
+class OutputBuffer;
+/// "x y z" of a position as text: shortest floats, or offset + p in shortest doubles.
+void write_position(OutputBuffer& o, const float* p, const double* offset);
 
 // ---- messages -------------------------------------------------------------------------------
 
@@ -120,11 +127,13 @@ public:
     }
     /// Shortest decimal that reads back as exactly `value` (std::to_chars).
     void real(float value);
+    void real(double value); ///< shortest text that reads back as the same double
     void integer(std::uint64_t value);
     void u8(std::uint8_t value) { character(static_cast<char>(value)); }
     void u16_le(std::uint16_t value);
     void u32_le(std::uint32_t value);
     void f32_le(float value);
+    void f64_le(double value);
     /// Writes what is left; call once at the end.
     void flush();
 

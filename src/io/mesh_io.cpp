@@ -190,6 +190,14 @@ void OutputBuffer::real(float value)
     maybe_flush();
 }
 
+void OutputBuffer::real(double value)
+{
+    char digits[40];
+    const auto result = std::to_chars(digits, digits + sizeof digits, value);
+    buffer_.append(digits, result.ptr);
+    maybe_flush();
+}
+
 void OutputBuffer::integer(std::uint64_t value)
 {
     char digits[24];
@@ -218,10 +226,29 @@ void OutputBuffer::f32_le(float value)
     u32_le(std::bit_cast<std::uint32_t>(value));
 }
 
+void OutputBuffer::f64_le(double value)
+{
+    const auto bits = std::bit_cast<std::uint64_t>(value);
+    u32_le(static_cast<std::uint32_t>(bits));
+    u32_le(static_cast<std::uint32_t>(bits >> 32));
+}
+
 void OutputBuffer::flush()
 {
     out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
     buffer_.clear();
+}
+
+void write_position(OutputBuffer& o, const float* p, const double* offset)
+{
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (k > 0) o.character(' ');
+        if (offset) {
+            o.real(offset[k] + static_cast<double>(p[k]));
+        } else {
+            o.real(p[k]);
+        }
+    }
 }
 
 // ---- dispatch -------------------------------------------------------------------------------
@@ -367,6 +394,12 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
     const std::string ext = detail::lower_extension(path);
     if (!detail::mesh_format(ext)) detail::unsupported_extension(name, ext);
     validate_for_writing(mesh, name);
+    const double* offset = options.offset ? options.offset->data() : nullptr;
+    if (offset && ext == ".stl") {
+        throw Error(Status::invalid_argument,
+                    detail::concat(name, ": STL stores 32-bit float positions; this mesh's world coordinates need double "
+                                         "precision (write .ply, .obj or .off)"));
+    }
     if (ext == ".stl" && mesh.triangle_count() > std::numeric_limits<std::uint32_t>::max()) {
         throw Error(Status::too_large, detail::concat(name,
                                                       ": binary STL holds at most 4294967295 "
@@ -375,13 +408,13 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
     }
     detail::write_atomically(path, [&](std::ostream& out) {
         if (ext == ".ply") {
-            detail::write_ply(mesh, out, options.ascii);
+            detail::write_ply(mesh, out, options.ascii, offset);
         } else if (ext == ".obj") {
-            detail::write_obj(mesh, out);
+            detail::write_obj(mesh, out, offset);
         } else if (ext == ".stl") {
             detail::write_stl(mesh, out);
         } else {
-            detail::write_off(mesh, out);
+            detail::write_off(mesh, out, offset);
         }
     });
 }

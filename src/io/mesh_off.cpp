@@ -155,7 +155,7 @@ Mesh read_off(std::string_view bytes, const std::string& name)
     return mesh;
 }
 
-void write_off(const Mesh& mesh, std::ostream& out)
+void write_off(const Mesh& mesh, std::ostream& out, const double* offset)
 {
     OutputBuffer o(out);
     o.text("OFF\n");
@@ -165,11 +165,7 @@ void write_off(const Mesh& mesh, std::ostream& out)
     o.text(" 0\n");
     const float* p = mesh.positions.data();
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-        o.real(p[3 * v]);
-        o.character(' ');
-        o.real(p[3 * v + 1]);
-        o.character(' ');
-        o.real(p[3 * v + 2]);
+        write_position(o, &p[3 * v], offset);
         o.character('\n');
     }
     const std::uint32_t* t = mesh.triangles.data();

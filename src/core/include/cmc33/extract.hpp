@@ -92,4 +92,15 @@ template <class T>
 CMC33_CORE_EXPORT Mesh extract(const GridView<T>& grid, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
 CMC33_CORE_EXPORT Mesh extract(const Volume& volume, double iso, const ExtractOptions& options = {}, ExtractStats* stats = nullptr);
 
+/// How finely 32-bit floats resolve a grid's cells in world space: 1 over the largest distance, in
+/// cells along any grid axis, that rounding a world position of the grid's box to float can move it
+/// (+inf where no component needs rounding). extract() keeps vertices at least 16 float steps from
+/// the samples, within 1/8 of an edge, and so needs kMinFloatStepsPerCell: far from the origin
+/// (scanner or map coordinates with fine cells) it refuses the grid with Error{too_large}.
+/// Extracting with the origin at 0 and adding it back in double precision keeps such a mesh
+/// embedded (cmc33 extract does so; docs/conventions.md).
+inline constexpr double kMinFloatStepsPerCell = 128;
+CMC33_CORE_EXPORT double float_steps_per_cell(const Index3& dims, const Vec3& spacing, const Vec3& origin,
+                                              const Mat3& direction);
+
 } // namespace cmc33

@@ -52,6 +52,11 @@ CMC33_IO_EXPORT void write_volume(const Volume& volume, const std::filesystem::p
 
 struct MeshWriteOptions {
     bool ascii = false; ///< PLY only: ASCII instead of binary little-endian
+    /// Set: the mesh's positions are relative to this point, and are written in double precision
+    /// as offset + position (PLY `property double`, shortest round-trip text in OBJ and OFF; STL,
+    /// 32-bit floats only, refuses it). For meshes extracted with the volume's origin moved to 0,
+    /// far from which floats cannot keep them embedded (float_steps_per_cell()).
+    std::optional<Vec3> offset{};
 };
 
 /// Writes .ply, .obj, .stl (binary) or .off. Normals are written where the format carries them
