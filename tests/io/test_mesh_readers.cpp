@@ -510,7 +510,7 @@ TEST(OffReader, Errors)
     expect_error("OFF\n", "m.off", Status::truncated_file, "before the counts line");
     expect_error("OFF\n3 x 0\n", "m.off", Status::bad_format, "line 2: expected the counts");
     expect_error("OFF\n1000000 1 0\n0 0 0\n", "m.off", Status::truncated_file,
-                 "the counts declare 1000000 vertices and 1 faces");
+                 "the counts declare 1000000 vertices and 1 face (");
     expect_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "m.off", Status::bad_format,
                  "line 6: face 0 uses vertex index 3 but the file has 3 vertices");
     expect_error("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n", "m.off", Status::bad_format,
