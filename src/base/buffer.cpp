@@ -88,6 +88,14 @@ public:
         }
         return nullptr;
     }
+    /// Releases every kept block p with release(p).
+    template <class Release> void release_all(const Release& release) noexcept
+    {
+        const std::lock_guard lock(mutex_);
+        for (Block& b : blocks_) {
+            if (b.p != nullptr) release(std::exchange(b.p, nullptr));
+        }
+    }
     /// Keeps p (of `bytes`) if it is small enough and a slot is free; false: the caller frees it.
     bool keep(void* p, std::size_t bytes) noexcept
     {
@@ -203,6 +211,13 @@ void deallocate_buffer(void* p, std::size_t bytes) noexcept
     } else if (p != nullptr && !LargeBlocks::instance().keep(p, whole_pages(bytes))) {
         aligned_free(p);
     }
+}
+
+void release_kept_buffers() noexcept
+{
+    MediumBlocks::instance().release_all([](void* p) noexcept { ::operator delete(p); });
+    LargeBlocks::instance().release_all([](void* p) noexcept { aligned_free(p); });
+    HugeBlocks::instance().release_all([](void* p) noexcept { aligned_free(p); });
 }
 
 } // namespace cmc33::detail

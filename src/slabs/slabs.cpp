@@ -17,7 +17,12 @@
 #include <type_traits>
 #include <utility>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "cmc33/error.hpp"
+#include "cmc33/mesh.hpp"
 #include "cmc33/passes.hpp"
 #include "mesh_formats.hpp"
 #include "parallel.hpp"
@@ -35,11 +40,15 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 constexpr std::int64_t kHalo = 2;
 
 /// Bytes per vertex and per triangle of a slab while it is emitted, written and analysed: the
-/// mesh arrays (12 per vertex for positions, 12 more for normals; 12 per triangle), the copy and
-/// working memory of mesh_geometry() and SeamTopology (measured on extracted meshes: about 75 per
-/// vertex and 100 per triangle), with a margin; without the analysis, the arrays and a margin.
-constexpr std::uint64_t kBytesPerVertex = 110, kBytesPerTriangle = 130;
+/// mesh arrays (12 per vertex for positions, 12 more for normals; 12 per triangle), and for the
+/// analysis, per vertex and triangle of the slab with the cell layers on either side, the combined
+/// copy and the working memory of mesh_geometry() (welded points, boxes, bucket entries) and
+/// SeamTopology (peak RSS on uniform noise, the most triangles per cell: about 60 per vertex and
+/// 150 per triangle), with a margin; without the analysis, the arrays and a margin.
+constexpr std::uint64_t kBytesPerVertex = 80, kBytesPerTriangle = 190;
 constexpr std::uint64_t kBytesPerVertexBare = 18, kBytesPerTriangleBare = 18;
+/// Bytes of the limit left for the process itself (code, libraries, stacks, the allocator's own).
+constexpr std::uint64_t kProcessBytes = std::uint64_t{12} << 20;
 
 std::uint64_t pieces(std::uint64_t bytes, std::size_t piece) { return (bytes + piece - 1) / piece; }
 
@@ -413,7 +422,9 @@ struct RangeRun::Impl {
                                 std::to_string(2 * (fixed + per_plane)) + " bytes (half for samples, half for the mesh)");
             }
             planes = std::clamp<std::int64_t>(static_cast<std::int64_t>((samples - fixed) / per_plane), 1, k1 - k0);
-            mesh_budget = limit - samples;
+            // the mesh has what the samples leave: small planes leave it most of the limit
+            const std::uint64_t used = fixed + static_cast<std::uint64_t>(planes) * per_plane;
+            mesh_budget = limit - used - std::min(kProcessBytes, (limit - used) / 4);
         }
         if (opt.max_slab_planes > 0) planes = std::min(planes, opt.max_slab_planes);
         const std::int64_t count = (k1 - k0 + planes - 1) / planes;
@@ -446,24 +457,50 @@ struct RangeRun::Impl {
         return counts;
     }
 
-    std::uint64_t estimate(std::int64_t vertices, std::int64_t triangles) const
+    /// Bytes of slab s's mesh and, with the analysis, of its work on the slab and the cell
+    /// layers around it (emit_slab: the layer below is analysed with the slab, the one above
+    /// lends its vertices).
+    template <class T> std::uint64_t estimate(const GridView<T>& g, const Slab& s) const
     {
         const std::uint64_t v = (opt.analyse ? kBytesPerVertex : kBytesPerVertexBare) + (opt.extract.normals ? 18 : 0);
         const std::uint64_t t = opt.analyse ? kBytesPerTriangle : kBytesPerTriangleBare;
-        return static_cast<std::uint64_t>(vertices) * v + static_cast<std::uint64_t>(triangles) * t;
+        auto vertices = static_cast<std::uint64_t>(s.vertices), triangles = static_cast<std::uint64_t>(s.triangles);
+        if (opt.analyse) {
+            const auto layer = [&](std::int64_t k) {
+                try {
+                    const RangeCounts c = cmc33::count(g, iso, opt.extract, k, k + 1);
+                    return std::array<std::uint64_t, 2>{static_cast<std::uint64_t>(c.vertex_count()),
+                                                        static_cast<std::uint64_t>(c.triangle_count())};
+                } catch (const Error& e) {
+                    // a non-finite sample beyond the slab is the next slab's to report
+                    if (e.status() != Status::non_finite) throw;
+                    return std::array<std::uint64_t, 2>{0, 0};
+                }
+            };
+            if (s.a > 0) {
+                const auto below = layer(s.a - 1);
+                vertices += below[0], triangles += below[1];
+            }
+            if (s.b < nz) {
+                const auto above = layer(s.b);
+                vertices += above[0], triangles += above[1] / 8; // its triangles are only held, 12 bytes each
+            }
+        }
+        return vertices * v + triangles * t;
     }
 
     /// Cuts slab [a, b) until each piece's mesh fits the budget; appends the pieces to `out`.
     template <class T> void fit(const GridView<T>& g, Slab s, std::vector<Slab>& out) const
     {
-        if (mesh_budget == 0 || estimate(s.vertices, s.triangles) <= mesh_budget) {
+        const std::uint64_t need = mesh_budget == 0 ? 0 : estimate(g, s);
+        if (need <= mesh_budget) {
             out.push_back(s);
             return;
         }
         if (s.b - s.a == 1) {
             throw Error(Status::too_large, "the mesh of sample plane " + std::to_string(s.a) + " alone (" +
                                                std::to_string(s.vertices) + " vertices, " + std::to_string(s.triangles) +
-                                               " triangles) needs about " + std::to_string(estimate(s.vertices, s.triangles)) +
+                                               " triangles) needs about " + std::to_string(need) +
                                                " bytes, more than --memory-limit leaves for the mesh (" +
                                                std::to_string(mesh_budget) + "); raise --memory-limit");
         }
@@ -552,6 +589,7 @@ struct RangeRun::Impl {
             for (const Slab& s : p.slabs) {
                 std::vector<RangeCounts> counts = kept ? std::move(kept_counts.front()) : count_threads(g, s.a, s.b);
                 emit_slab(g, s, counts, fv, ft, bound, writer, result);
+                if (opt.memory_limit > 0) release_memory();
                 fv += s.vertices;
                 ft += s.triangles;
             }
@@ -564,6 +602,17 @@ struct RangeRun::Impl {
         kept = false;
         kept_counts.clear();
         return result;
+    }
+
+    /// Hands back to the system what a slab's mesh and analysis freed: blocks kept by the mesh
+    /// allocator for sizes the next slab may not ask for, and free pages glibc keeps in its heaps
+    /// (fragmented by the analysis, they held more and more of them from slab to slab).
+    static void release_memory() noexcept
+    {
+        detail::release_kept_buffers();
+#if defined(__GLIBC__)
+        malloc_trim(0);
+#endif
     }
 
     template <class T>

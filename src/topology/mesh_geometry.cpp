@@ -63,7 +63,11 @@ public:
         weld();
         classify_triangles();
         test_all_levels();
-        result_.welded = mesh_topology(welded_mesh());
+        release_search();
+        Mesh welded = welded_mesh();
+        std::vector<std::uint32_t>().swap(welded_id_);
+        std::vector<Point3>().swap(points_);
+        result_.welded = mesh_topology(welded);
         return result_;
     }
 
@@ -104,18 +108,21 @@ private:
     void weld()
     {
         const std::size_t n = mesh_.vertex_count();
-        std::vector<std::uint8_t> used(n, 0);
-        for (std::uint32_t v : mesh_.triangles) used[v] = 1;
         std::vector<std::uint32_t> order;
-        order.reserve(n);
-        for (std::size_t v = 0; v < n; ++v)
-            if (used[v]) order.push_back(static_cast<std::uint32_t>(v));
+        {
+            std::vector<std::uint8_t> used(n, 0);
+            for (std::uint32_t v : mesh_.triangles) used[v] = 1;
+            order.reserve(static_cast<std::size_t>(std::count(used.begin(), used.end(), std::uint8_t{1})));
+            for (std::size_t v = 0; v < n; ++v)
+                if (used[v]) order.push_back(static_cast<std::uint32_t>(v));
+        }
         std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
             const Point3 pa = position(a), pb = position(b);
             return pa != pb ? pa < pb : a < b;
         });
         welded_id_.assign(n, 0);
         points_.clear();
+        points_.reserve(order.size()); // at most one position per used vertex, without growing past it
         for (std::size_t i = 0; i < order.size();) {
             std::size_t j = i + 1;
             const Point3 p = position(order[i]);
@@ -223,12 +230,15 @@ private:
         for (std::size_t t = 0; t < proper_.size(); ++t)
             if (proper_[t]) unplaced.push_back(static_cast<std::uint32_t>(t));
         std::vector<std::uint32_t> placed;
+        placed.reserve(unplaced.size());
         for (int level = 0; !unplaced.empty(); ++level) {
-            std::vector<double> extents(unplaced.size());
-            for (std::size_t i = 0; i < unplaced.size(); ++i) extents[i] = extent_of(boxes_[unplaced[i]]);
-            const std::size_t p90 = extents.size() * 9 / 10;
-            std::nth_element(extents.begin(), extents.begin() + static_cast<std::ptrdiff_t>(p90), extents.end());
-            cell_ = 2 * extents[p90];
+            {
+                std::vector<double> extents(unplaced.size());
+                for (std::size_t i = 0; i < unplaced.size(); ++i) extents[i] = extent_of(boxes_[unplaced[i]]);
+                const std::size_t p90 = extents.size() * 9 / 10;
+                std::nth_element(extents.begin(), extents.begin() + static_cast<std::ptrdiff_t>(p90), extents.end());
+                cell_ = 2 * extents[p90];
+            }
             for (std::size_t k = 0; k < 3; ++k)
                 cell_ = std::max(cell_, (top_[k] - origin_[k]) / static_cast<double>(kCellsPerAxis - 2));
             if (!(cell_ > 0)) cell_ = 1;
@@ -252,7 +262,15 @@ private:
 
     void bucket(const std::vector<std::uint32_t>& triangles)
     {
+        // counted first: growing the array by doubling held up to three times its size at once
+        std::size_t count = 0;
+        for (std::uint32_t t : triangles) {
+            const auto c0 = cell_of(boxes_[t].lo), c1 = cell_of(boxes_[t].hi);
+            count += static_cast<std::size_t>((c1[0] - c0[0] + 1) * (c1[1] - c0[1] + 1) * (c1[2] - c0[2] + 1));
+        }
+        if (entries_.capacity() < count) std::vector<Entry>().swap(entries_);
         entries_.clear();
+        entries_.reserve(count);
         for (std::uint32_t t : triangles) {
             const auto c0 = cell_of(boxes_[t].lo), c1 = cell_of(boxes_[t].hi);
             for (std::int64_t z = c0[2]; z <= c1[2]; ++z)
@@ -340,6 +358,16 @@ private:
         std::sort(all.begin(), all.end());
         if (all.size() > options_.examples) all.resize(options_.examples);
         result_.intersection_examples = std::move(all);
+    }
+
+    /// Frees the arrays of the pair search, before the welded mesh and its topology are made.
+    void release_search()
+    {
+        std::vector<std::uint8_t>().swap(proper_);
+        std::vector<Box>().swap(boxes_);
+        std::vector<int>().swap(level_);
+        std::vector<Entry>().swap(entries_);
+        std::vector<std::size_t>().swap(groups_);
     }
 
     Mesh welded_mesh() const

@@ -23,6 +23,9 @@ namespace detail {
 /// @throws Error{too_large} "cannot allocate N bytes for the mesh (out of memory)"
 CMC33_BASE_EXPORT void* allocate_buffer(std::size_t bytes);
 CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
+/// Frees every kept block: for a caller bound to a memory limit (the slabs of --memory-limit),
+/// where blocks kept for sizes that never come again would add up past it.
+CMC33_BASE_EXPORT void release_kept_buffers() noexcept;
 } // namespace detail
 
 /// std::allocator, except that resize(n) leaves new elements default-initialised (for float and
