@@ -46,6 +46,7 @@
 #include "cube.hpp"
 #include "decide.hpp"
 #include "parallel.hpp"
+#include "plural.hpp"
 #include "placement.hpp"
 #include "portability.hpp"
 #include "refine.hpp"
@@ -266,7 +267,8 @@ template <class T> double scan_samples(const GridView<T>& g, std::int64_t k_lo, 
                     largest = std::max(largest, v);
                 }
         if (count > 0) {
-            throw Error(Status::non_finite, std::to_string(count) + " samples are NaN or infinite, the first at (" +
+            throw Error(Status::non_finite, counted(count, "sample") + (count == 1 ? " is" : " are") +
+                                                " NaN or infinite, the first at (" +
                                                 std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " +
                                                 std::to_string(first[2]) + "); cmc33 needs finite samples");
         }

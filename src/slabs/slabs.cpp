@@ -26,6 +26,7 @@
 #include "cmc33/passes.hpp"
 #include "mesh_formats.hpp"
 #include "parallel.hpp"
+#include "plural.hpp"
 
 namespace cmc33::slabs {
 
@@ -790,8 +791,9 @@ std::uint64_t parse_size(const std::string& text)
 
 std::string non_finite_message(std::int64_t count, const Index3& first)
 {
-    return std::to_string(count) + " samples are NaN or infinite, the first at (" + std::to_string(first[0]) + ", " +
-           std::to_string(first[1]) + ", " + std::to_string(first[2]) + "); cmc33 needs finite samples";
+    return counted(count, "sample") + (count == 1 ? " is" : " are") + " NaN or infinite, the first at (" +
+           std::to_string(first[0]) + ", " + std::to_string(first[1]) + ", " + std::to_string(first[2]) +
+           "); cmc33 needs finite samples";
 }
 
 } // namespace cmc33::slabs

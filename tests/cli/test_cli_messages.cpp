@@ -329,6 +329,17 @@ TEST(CliMessages, CountsOfOneAreSingular)
     // the readers' messages too
     expect_message(run("topo " + quote(write_text(dir / "v.off", "OFF\n1 0 0\n0      \n").string())), 1,
                    "vertex 0 has 1 number; expected 3");
+    // one NaN sample, in memory and slab by slab
+    io::write_volume(test::make_volume({3, 3, 3}, [](auto i, auto j, auto k) {
+                         return i == 1 && j == 2 && k == 0 ? std::numeric_limits<double>::quiet_NaN() : 0.0;
+                     }),
+                     dir / "nan.nrrd");
+    for (const char* limit : {"", " --memory-limit 64M"}) {
+        const Result n = run("extract " + quote((dir / "nan.nrrd").string()) + " --iso 0.5" + limit);
+        EXPECT_EQ(n.code, 1);
+        EXPECT_NE(n.err.find("1 sample is NaN or infinite, the first at (1, 2, 0)"), std::string::npos) << limit << n.err;
+        expect_singular_after_one(n.err);
+    }
     // and the check itself catches what it is for
     EXPECT_NONFATAL_FAILURE(expect_singular_after_one("a.raw: 2x2x2 (1 samples, 8 bytes)"), "1 samples");
 }
