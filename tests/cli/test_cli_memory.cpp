@@ -79,6 +79,16 @@ std::size_t entries(const fs::path& dir)
     return n;
 }
 
+/// `count` random bytes (uint8 noise: the roughest surfaces, the most triangles per sample) at `path`.
+fs::path write_noise(const fs::path& path, std::size_t count)
+{
+    std::string bytes(count, '\0');
+    std::mt19937 rng(9);
+    for (char& c : bytes) c = static_cast<char>(rng() & 0xff);
+    test::write_file(path, bytes);
+    return path;
+}
+
 class OutOfMemory : public ::testing::Test {
 protected:
     void SetUp() override
@@ -115,11 +125,7 @@ TEST_F(OutOfMemory, ARawVolumeLargerThanTheLimitIsRefusedNamingItsSize)
 TEST_F(OutOfMemory, AMeshLargerThanTheLimitIsRefusedNamingTheVolume)
 {
     // 160^3 random bytes: 4 MB in, 7 million vertices and 15 million triangles out (270 MB).
-    const fs::path raw = dir_ / "noise.raw";
-    std::string bytes(160 * 160 * 160, '\0');
-    std::mt19937 rng(9);
-    for (char& c : bytes) c = static_cast<char>(rng() & 0xff);
-    test::write_file(raw, bytes);
+    const fs::path raw = write_noise(dir_ / "noise.raw", 160 * 160 * 160);
     const fs::path mesh = out_ / "noise.ply";
     const std::string args = "extract " + quote(raw.string()) + " --dims 160 160 160 --type uint8 -i 127.5 " +
                              "--threads 2 -o " + quote(mesh.string());
@@ -172,11 +178,7 @@ TEST_F(OutOfMemory, TheMemoryLimitHoldsForTheWholeRunWithTheChecksOnNoise)
     // 192x128x14 random bytes: 1.2 million triangles, each slab one or two planes; the checks'
     // working memory (mesh_geometry) held more than the estimate, and what each slab freed stayed
     // in the process (peak 66 MiB at 64M).
-    const fs::path raw = dir_ / "noise.raw";
-    std::string bytes(192 * 128 * 14, '\0');
-    std::mt19937 rng(9);
-    for (char& c : bytes) c = static_cast<char>(rng() & 0xff);
-    test::write_file(raw, bytes);
+    const fs::path raw = write_noise(dir_ / "noise.raw", 192 * 128 * 14);
     const long peak = peak_kib("extract " + quote(raw.string()) + " --dims 192 128 14 --type uint8 -i 127.5 --threads 2 " +
                                "--memory-limit 64M -o " + quote((out_ / "noise.ply").string()));
     ASSERT_GT(peak, 0) << "cmc33 extract --memory-limit 64M failed";

@@ -62,7 +62,12 @@ export class Viewer {
     if (box.isEmpty()) return;
     const center = box.getCenter(new THREE.Vector3());
     const size = box.getSize(new THREE.Vector3()).length();
-    this.camera.position.copy(center).add(new THREE.Vector3(0.55, -0.95, 0.75).multiplyScalar(size * 1.0));
+    this.lookFrom(center, size, new THREE.Vector3(0.55, -0.95, 0.75).multiplyScalar(size));
+  }
+
+  /** The camera at center + offset, looking at center, z up, clipping for a scene of `size`. */
+  lookFrom(center, size, offset) {
+    this.camera.position.copy(center).add(offset);
     this.camera.up.set(0, 0, 1);
     this.camera.near = size / 1000;
     this.camera.far = size * 100;
@@ -80,14 +85,8 @@ export class Viewer {
     // far enough that the box's bounding sphere fits the narrower of the view's angles
     const half = THREE.MathUtils.degToRad(this.camera.fov / 2);
     const narrow = Math.min(half, Math.atan(Math.tan(half) * this.camera.aspect));
-    this.camera.position.copy(center).add(new THREE.Vector3(0.55, -0.95, 0.75).normalize().multiplyScalar((size / 2 / Math.sin(narrow)) * 0.9));
-    this.camera.up.set(0, 0, 1);
-    this.camera.near = size / 1000;
-    this.camera.far = size * 100;
-    this.camera.updateProjectionMatrix();
-    this.controls.target.copy(center);
-    this.controls.update();
-    this.fitted = true;
+    const distance = (size / 2 / Math.sin(narrow)) * 0.9;
+    this.lookFrom(center, size, new THREE.Vector3(0.55, -0.95, 0.75).normalize().multiplyScalar(distance));
     this.render();
   }
 
