@@ -68,7 +68,7 @@ Ply read_positions(const fs::path& path)
             } else {
                 float x;
                 std::memcpy(&x, p + 4 * c, 4);
-                ply.positions.push_back(x);
+                ply.positions.push_back(static_cast<double>(x));
             }
         }
     }

@@ -43,7 +43,8 @@ NormalFaults normal_faults(const Mesh& m)
     }
     NormalFaults f;
     for (std::size_t v = 0; v < m.vertex_count(); ++v) {
-        const double n[3] = {m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
+        const double n[3] = {static_cast<double>(m.normals[3 * v]), static_cast<double>(m.normals[3 * v + 1]),
+                             static_cast<double>(m.normals[3 * v + 2])};
         if (std::fabs(std::hypot(n[0], n[1], n[2]) - 1) > 1e-5) ++f.not_unit;
         if (n[0] * faces[v][0] + n[1] * faces[v][1] + n[2] * faces[v][2] <= 0) ++f.against;
     }
