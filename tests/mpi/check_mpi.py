@@ -207,7 +207,7 @@ def case_seams(c):
 
 def case_limits(c):
     bucky = os.path.join(c.data, "Bucky_32x32x32_uint8.nrrd")
-    c.compare(bucky, ["-i", "100", "--normals"], ranks=(1, 2, 3), mpi_args=("--memory-limit", "300k"))
+    c.compare(bucky, ["-i", "100", "--normals"], ranks=(1, 2, 3), mpi_args=("--memory-limit", "1M"))
     path = os.path.join(c.work, "limits.nrrd")
     dims = (160, 150, 40)
     values = []
@@ -216,7 +216,7 @@ def case_limits(c):
             for i in range(dims[0]):
                 values.append(min(255, int(((i - 80) ** 2 + (j - 75) ** 2 + (3 * (k - 20)) ** 2) ** 0.5)))
     nrrd(path, dims, "uint8", "B", values, encoding="gzip")
-    c.compare(path, ["-i", "60.5"], ranks=(1, 2, 4), mpi_args=("--memory-limit", "1M"))
+    c.compare(path, ["-i", "60.5"], ranks=(1, 2, 4), mpi_args=("--memory-limit", "5M"))
 
 
 def case_errors(c):
