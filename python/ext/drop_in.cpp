@@ -27,10 +27,9 @@ namespace {
 
 // Ranges of about 16 sample planes with threads, 64 with one: the stop flag is read between
 // ranges, so a range of 512^2 planes ends a Ctrl-C wait in tens of milliseconds, while the planes
-// a range reads twice (its ends) and its setup stay a small share (on one thread, 16 planes cost
-// 5-10 % more on aneurism, CThead and sines 512^3). With threads, at least 4 ranges per thread,
-// as extract() does, for uneven surfaces (bonsai on 2 threads: 21 ms with 16-plane ranges, 27 ms
-// with 32).
+// a range reads twice (its ends) and its setup stay a small share (which is why one thread takes
+// 64). With threads, at least 4 ranges per thread, as extract() does, so that uneven surfaces
+// still end the threads together.
 constexpr std::int64_t kPlanesPerRange = 16;
 constexpr std::int64_t kPlanesPerRangeAlone = 64;
 constexpr std::int64_t kMinRanges = 32;

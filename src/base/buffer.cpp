@@ -2,34 +2,21 @@
 // once, in parallel; with 4 KiB pages most of that time goes to page faults. Blocks of 1 MiB and
 // more are rounded up to whole 2 MiB pages, aligned to 2 MiB and advised for transparent huge
 // pages (Linux, when THP is in "madvise" or "always" mode; elsewhere the advice is ignored and
-// they are plain pages, of which only the ones written count). From 4 MiB down to 2 MiB: stent's
-// positions and normals (2 MiB each) took 512 faults apiece, 4 % of its extraction; one-shot runs
-// (cmc33 extract --normals --repeat 1, median of 21 processes) went from 9.78 to 8.90 ms on stent
-// and from 7.85 to 7.30 ms on aneurism. From 1 MiB, and the tail of a block in a huge page of its
-// own (a VM where a 4 KiB fault is dear; medians of 16-30 processes, builds alternating): aneurism 21.7 ->
-// 14.7 ms, stent 29.7 -> 13.1 ms, sphere 256^3 30.5 -> 19.3 ms, bonsai 36.1 -> 31.7 ms; the peak
-// RSS of `cmc33 extract` on aneurism 28.4 -> 32.0 MiB (at most 2 MiB more per block).
+// they are plain pages, of which only the ones written count), at most 2 MiB more per block.
 // Freed blocks of up to 16 MiB are kept, up to four, for the next allocation of the same size:
 // repeated extractions (an isovalue sweep, `--repeat`, a Python loop) then write memory that is
-// already mapped, as glibc's heap gave them for blocks below its mmap threshold before the
-// rounding (aneurism, `--repeat 5`, one thread, normals: 9.0 ms with the heap, 12.7 ms with fresh
-// huge pages every time on the VM above).
+// already mapped, as glibc's heap would for blocks below its mmap threshold.
 // Larger blocks (a mesh of about 1.4 M vertices and more) are rounded up to a size class as
 // medium ones are, and up to four are kept too; an allocation that none of them fits releases
 // them all first, so that memory is held only for a next mesh of about the same size and never
 // beside a mesh of another: the peak stays that of one mesh, and what stays mapped after a mesh
-// is freed is at most that mesh's arrays. On this VM memory that another process freed is often
-// handed back to the host, and the first writes to it cost about 2 ms per MiB: sines 512^3
-// (15.5 M triangles, 372 MB of arrays), `cmc33 extract --normals --threads 1 --repeat 5` after
-// a VTK run, three processes: runs 1.15-1.69 s, then 0.33-0.43 s with these blocks kept, where
-// fresh blocks gave one or two more runs of 0.78-1.05 s among 0.36-0.43 s.
-// On such a VM (a balloon that reports free memory: advise_huge_blocks below) no block is advised
-// for huge pages: a new huge page there is the dearest memory to write first.
+// is freed is at most that mesh's arrays.
+// On a VM whose balloon reports free memory (advise_huge_blocks below) no block is advised for
+// huge pages: a new huge page there is the dearest memory to write first.
 // Blocks from 64 KiB to 1 MiB are glibc's too, but above its mmap threshold it maps them afresh
 // for each allocation, a fault per page written: they are rounded up to a size class (the next
 // eighth of their power of two, so that meshes of nearly the same size share one) and up to
-// eight are kept the same way (`cmc33 extract --normals --threads 1 --repeat 21`, medians,
-// alternating: silicium 98x34x34, 40 k triangles, 1.04 -> 0.68 ms; HeadMRVolume 1.87 -> 1.33 ms).
+// eight are kept the same way. The measurements behind each rule: docs/performance.md, "Memory".
 // A failed allocation says how many bytes it wanted: a mesh too large for memory (or for
 // `ulimit -v`) is reported as such, and the command line names the file it came from.
 
@@ -142,19 +129,9 @@ std::size_t size_class(std::size_t bytes) noexcept
 
 /// Whether new blocks are advised for huge pages: not on a VM whose balloon hands free memory back
 /// to its host (balloon_reports_free_memory, read once). There a new huge page comes from the
-/// blocks handed back, and its first writes take a fault in the host per 4 KiB: on the 2-CPU VM
-/// of the README's runs, writing 2 MiB took 4.5-6.0 ms in a huge page against 0.74-2.0 ms in
-/// 4 KiB pages (0.17-0.21 ms in a huge page the process had just freed, of which there are few).
-/// `cmc33 extract --normals --threads 1 --repeat 11|21` (taskset -c 0), builds alternating, the
-/// first extraction (which writes the mesh's blocks for the first time) with the advice against
-/// without it, right after a VTK run: aneurism 13.3-35.9 against 10.6-12.1 ms, CThead at 1500.5
-/// 13.5-49.7 against 18.7-18.8, LIDC2 at 60.5 20.5-65.6 against 28.8-31.9, bonsai 67-91 against
-/// 38-40, sines 512^3 1125-1363 against 506-706, noise 128^3 407-571 against 266-268; in a row
-/// without a VTK run, bonsai 27-117 (mean 59) against 38-58 (mean 43), mri_head 42-160 against
-/// 61-64. Later extractions reuse the kept blocks, and 4 KiB pages cost them little: medians
-/// aneurism 7.43-8.18 against 7.48-7.70 ms, mri_head 37.27-38.76 against 37.73-38.34, bonsai
-/// 23.79-24.22 against 24.33-25.03 (the most: 1.5-2 %, 27 MB of triangles, positions and
-/// normals). Before 2dd20b3 only blocks past 64 MiB (25c3f4e), then past 32 MiB, went unadvised.
+/// blocks handed back, and its first writes take a fault in the host per 4 KiB, several times
+/// what the same bytes cost in 4 KiB pages; later extractions reuse the kept blocks, so 4 KiB
+/// pages cost them little (docs/performance.md, "Memory").
 bool advise_huge_blocks() noexcept
 {
     static const bool advise = !balloon_reports_free_memory();

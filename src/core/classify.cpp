@@ -242,10 +242,8 @@ CMC33_AVX2 Signs classify_avx2_real(const T* row, std::int64_t n, const Threshol
     using V = typename L::V;
     const V t = L::splat(th.value), abs_mask = L::abs_mask(), inf = L::splat(std::numeric_limits<T>::infinity());
     // the largest |sample| of the finite ones, in two accumulators (even and odd vectors) so that
-    // the chain of max is half as long; a non-finite sample counts as 0 (and_not, off the chain,
-    // where a blend was: sphere 256^3 float, one thread, normals, medians of 10 processes
-    // alternating, 11.76 -> 11.26 ms and 11.85 -> 11.67 ms; a software prefetch 2 KiB ahead
-    // gained nothing more)
+    // the chain of max is half as long; a non-finite sample counts as 0 (and_not, which keeps the
+    // chain free of a blend)
     V largest[2] = {L::splat(0), L::splat(0)};
     V bad = L::splat(0);
     // the above-bits of the vector at p; its samples join the scan in accumulator `q`

@@ -1,6 +1,6 @@
 #pragma once
 // The pass that reads every sample: a row of samples becomes a bitmask of above-flags (bit i of
-// word i / 64: sample i is above, the sign rule v >= iso of design.md), 64 samples per word.
+// word i / 64: sample i is above, the sign rule v >= iso of docs/conventions.md), 64 samples per word.
 // Everything after it (which rows and cells cross, case codes, counts) works on these words with
 // bit operations, so that a row far from the surface costs a few word operations.
 //

@@ -2,7 +2,7 @@
 // The one definition of corner, edge and face numbering (tools/gen_tables/cube.py mirrors it).
 //
 //          6 ---------- 7          bit c of a case code  <=>  corner c is above iso
-//         /|           /|          (value >= iso: the sign rule of design.md)
+//         /|           /|          (value >= iso: the sign rule, docs/conventions.md)
 //        4 ---------- 5 |          z
 //        | |          | |          |  y
 //        | 2 ---------|-3          | /

@@ -3,7 +3,7 @@
 // kernel (no report, no strings), used by the extractor's passes and by analyze_cell(), which
 // derives its report from the Decision (cell.cpp).
 //
-// Values are differences to iso. The sign rule (design.md): a value >= 0 is above. It applies to
+// Values are differences to iso. The sign rule (docs/conventions.md): a value >= 0 is above. It applies to
 // samples, face saddles and the saddles of the sweeping slices alike.
 //
 // Every decision is the sign of a polynomial (degree <= 6) in the eight values. It is computed
@@ -456,9 +456,8 @@ inline Decision decide_expansion(const double* raw, double iso, const double* v,
 /// multiples of a power of two (integer data, and integer-valued floats such as CT stored as
 /// float32: their ties cost what integer data's do), else in filtered arithmetic with the eps
 /// terms and then in rationals. A corner equal to iso is a 0 sign the filter cannot settle: such
-/// cells of integer data go straight to the integers. (Integer data used to be decided in 128-bit
-/// integers first: stagbeetle 138x138x82 uint16 at 500.5, 20 k decided cells, one thread: count
-/// 2.12 -> 1.59 ms, `cmc33 extract --normals` 5.1 -> 4.5 ms.)
+/// cells of integer data go straight to the integers. The filter comes first because it is the
+/// cheaper of the two on cells without ties (docs/performance.md).
 /// `raw`: the eight corner samples (corner order of cube.hpp). `table`: the method's table set
 /// (tables_of(method)); Decision::variant points into it.
 inline Decision decide(const double* raw, double iso, unsigned config, Method method, const Variant* table = kVariants)

@@ -1,4 +1,4 @@
-// extract(): Marching Cubes 33 in passes (design.md, after VTK's Flying Edges), public in
+// extract(): Marching Cubes 33 in passes (docs/design.md, after VTK's Flying Edges), public in
 // src/core/include/cmc33/passes.hpp, each over a range of sample planes [k0, k1):
 //   1. count: per row of cells, the case code of each cell from the rows' above-flags (rows whose
 //      samples are all on one side are skipped), the face and interior tests of the cells that
@@ -101,8 +101,7 @@ CMC33_ALWAYS_INLINE Word next_sample(const Word* m, std::int64_t w) { return m[w
 /// The above-flags of sample rows, for three consecutive slices at once (slice k lives in buffer
 /// k mod 3): a pass over cell rows (j, k) reads slices k..k+2 at most. Each row is classified once
 /// per thread, with its signs (detail::RowSigns): on demand through get() (emit), or in order by
-/// count() itself (plane_words()), which saves get()'s bookkeeping (aneurism 80.5, one thread:
-/// count 2.59 -> 2.47 ms).
+/// count() itself (plane_words()), which saves get()'s bookkeeping.
 class SliceMasks {
 public:
     SliceMasks(std::int64_t nx, std::int64_t ny)
@@ -641,8 +640,8 @@ private:
 
     /// One thread's working memory: above-flags of three slices (3 nx ny / 8 bytes), vertex ids
     /// of four sample rows (emit), and what classifying the rows saw. emit classifies the rows it
-    /// needs again rather than keeping count's: on a dense surface (sines 512^3) reading them back
-    /// cost more than the vector compare (0.304 -> 0.365 s), on a sparse one it saved 3%.
+    /// needs again rather than keeping count's: on a dense surface reading them back costs more
+    /// than the vector compare, and on a sparse one it saves little.
     struct Scratch {
         Scratch(std::int64_t nx, std::int64_t ny) : masks(nx, ny), ids(nx) {}
         SliceMasks masks;
@@ -723,11 +722,7 @@ private:
     /// is the array's contiguous axis, 8 cells at a time from the first crossed cell not yet
     /// done, in a loop the compiler vectorizes (a group may reach into the next word's cells,
     /// which that word computes again); else, and for the row's last cells, cell by cell.
-    /// (cmc33.marching_cubes, one thread: sines 512^3 334 -> 325 ms, CThead 13.0 -> 11.6 ms
-    /// against cell by cell; groups aligned to 8 cells took 3.5 % longer on bonsai; groups of 4
-    /// lost 10 % on CThead and bonsai, of 16 3 % on sines; for 8-bit samples the whole row at
-    /// once was 1.5 % faster on bonsai, and an AVX2 build of the groups 0.5 % on sines: not worth
-    /// a second path.)
+    /// Unaligned groups of 8 measured best (docs/performance.md, "Python").
     void write_cell_ranges(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s) const
     {
         // the narrowest type whose difference, rounded to float, is cell_range()'s: float for
@@ -752,7 +747,7 @@ private:
                     const std::int64_t i = 64 * w + first;
                     if (i + 8 >= nx_) break; // the last cells read past the row: one by one
                     // cell_range()'s tree spelled out on the four rows: through a shared helper
-                    // the loop stopped vectorizing (CThead 11.3 -> 12.8 ms)
+                    // the loop stops vectorizing
                     for (std::int64_t q = i; q < i + 8; ++q) {
                         const T low = std::min(std::min(std::min(a[q], a[q + 1]), std::min(b[q], b[q + 1])),
                                                std::min(std::min(c[q], c[q + 1]), std::min(d[q], d[q + 1])));
@@ -901,8 +896,8 @@ private:
     /// vertex and at most kShortTiling triangles, where each id of their triangles sits in the
     /// four id rows of IdRows, so that emit_row_cells goes from a cell's code to its ids in two
     /// loads. The offsets are 16 bits, a table of 24 KiB that stays in the L1 cache better than
-    /// 32-bit ones did (emit, one thread: nucleon 157 -> 151 us, aneurism about 1 % less); grids
-    /// wider than 7281 samples, where they would not fit, have none (every cell takes emit_cell()).
+    /// 32-bit ones; grids wider than 7281 samples, where they would not fit, have none (every
+    /// cell takes emit_cell()).
     void build_short_tilings()
     {
         short_count_.fill(-1);

@@ -43,8 +43,7 @@ template <std::size_t S> CMC33_ALWAYS_INLINE void transpose_tile(std::uint64_t (
 /// along x and z transposed in 64-bit words: one load and one store per n samples instead of one
 /// per sample. Samples past whole tiles go one by one. The runs kAhead samples on along x are
 /// fetched ahead: they lie a plane of the grid apart, which the hardware does not fetch ahead
-/// (bonsai 256^3 through cmc33.marching_cubes, one thread: float32 114 -> 84 ms, int16 80 -> 69
-/// ms, uint8 55 -> 52 ms; 32 runs ahead was no faster).
+/// (docs/performance.md, "Python": Fortran order).
 template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to)
 {
     constexpr std::int64_t n = 8 / sizeof(T);
@@ -78,10 +77,8 @@ template <class T> void copy_z_runs(const GridView<T>& g, std::int64_t lo, std::
 /// samples (n a cache line's worth, at least 8), so that each line a tile reads (one per x) and
 /// writes (one per inner sample) is used whole. x tiles outermost, then the rows of the third
 /// axis, whose lines kAhead rows on are fetched ahead: a window of a few planes of a z-innermost
-/// grid reads runs of a line or two, 2 KB and more apart, which the hardware does not fetch ahead.
-/// (bonsai 256^3 through cmc33.marching_cubes, one thread, against the previous runs one sample
-/// at a time: float64 Fortran order 257 -> 139 ms, y innermost int16 148 -> 48 ms, float64
-/// 366 -> 96 ms; C order 40 ms.)
+/// grid reads runs of a line or two, 2 KB and more apart, which the hardware does not fetch ahead
+/// (docs/performance.md, "Python": Fortran order).
 template <class T>
 void copy_tiles(const GridView<T>& g, std::int64_t lo, std::int64_t hi, std::int64_t plane, T* to, bool z_inner)
 {
