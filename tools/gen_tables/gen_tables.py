@@ -2,7 +2,7 @@
 """Generates src/tables/mc33_tables.cpp: the Marching Cubes 33 triangulations of every
 (sign configuration, face decisions, interior decision), from first principles.
 
-How (design.md, "Tables"):
+How (docs/design.md, "Tables"):
  1. Face decisions give the boundary loops of the surface on the cell's faces (loops.py).
  2. The subcase follows from the base case (orbit of the configuration under the 24 rotations and
     complement) and the loops; Chernyaev's numbering (Chernyaev 1995; Custodio et al. 2013, Sec. 3).
