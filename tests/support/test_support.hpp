@@ -21,11 +21,12 @@ struct VolumeCase {
     const char* file;
     double iso;
 };
-/// Every volume of ../shared/data/volumes with one README isovalue each.
+/// Every test volume (CONTRIBUTING.md, "Test volumes") with one README isovalue each.
 const std::vector<VolumeCase>& shared_volume_cases();
 void PrintTo(const VolumeCase& c, std::ostream* os);
 
-/// Path of a volume in ../shared/data/volumes, or nullopt when shared/ is not beside the repo.
+/// Path of a test volume in $CMC33_SHARED/data/volumes (CMake's CMC33_SHARED_DIR, ../shared by
+/// default; CONTRIBUTING.md, "Test volumes"), or nullopt when it is absent.
 std::optional<std::filesystem::path> shared_volume(const std::string& file_name);
 
 /// Folder of the repository's small test files (tests/data).
