@@ -18,7 +18,7 @@ set -euo pipefail
 # libgdcm-dev and libtiff-dev are the DICOM and TIFF readers' libraries (without them the build
 # configures and refuses those formats by name); python3-pydicom and python3-tifffile write the
 # volumes the DICOM and TIFF tests read (tests/io/*.py), as independent writers.
-packages=(g++ cmake ninja-build pkg-config zlib1g-dev libgmp-dev libgtest-dev libgmock-dev
+packages=(g++ cmake ninja-build pkg-config zlib1g-dev libdeflate-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev
           libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile)
 for flag in "$@"; do
