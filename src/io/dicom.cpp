@@ -1,0 +1,1221 @@
+// DICOM volumes through GDCM (contract in dicom.hpp; what is read and refused: docs/formats.md).
+//
+// Two passes. The first reads each file's header up to its Pixel Data (GDCM stops there) and
+// keeps what grouping, sorting and the frame need. The second reads the samples of the chosen
+// series only: native transfer syntaxes straight from the file at the offset the first pass
+// found (no second parse), the others through GDCM's decoders (JPEG, JPEG-LS, JPEG 2000, RLE,
+// deflate).
+
+#include "dicom.hpp"
+#include "tiff.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "atomic_file.hpp"
+#include "byte_source.hpp"
+#include "portability.hpp"
+#include "volume_formats.hpp"
+
+#if CMC33_WITH_GDCM
+#include <gdcmDataSet.h>
+#include <gdcmFile.h>
+#include <gdcmImage.h>
+#include <gdcmImageReader.h>
+#include <gdcmReader.h>
+#include <gdcmSequenceOfItems.h>
+#include <gdcmTrace.h>
+#include <gdcmTransferSyntax.h>
+#endif
+
+namespace cmc33::io::detail {
+
+namespace fs = std::filesystem;
+
+bool has_dicom_mark(std::string_view head) noexcept
+{
+    return head.size() >= 132 && head.substr(128, 4) == "DICM";
+}
+
+namespace {
+
+/// The first 132 bytes of a regular file ("" when it cannot be read).
+std::string file_head(const fs::path& path)
+{
+    try {
+        const InputFile file(path, path.string());
+        return file.read_string(0, 132);
+    } catch (const Error&) {
+        return {};
+    }
+}
+
+bool dicom_extension(const fs::path& path)
+{
+    const std::string ext = lower_extension(path);
+    return ext == ".dcm" || ext == ".dicom" || ext == ".ima";
+}
+
+bool is_dicomdir_name(const fs::path& path)
+{
+    return equals_ignore_case(path.filename().string(), "DICOMDIR");
+}
+
+/// The regular files under `folder` (recursively, hidden entries skipped), sorted by name so that
+/// messages come in a fixed order. DICOMDIR files are left out: they index, they hold no image.
+std::vector<fs::path> folder_files(const fs::path& folder)
+{
+    std::vector<fs::path> files;
+    std::error_code ec;
+    fs::recursive_directory_iterator it(folder, fs::directory_options::skip_permission_denied, ec), end;
+    if (ec) throw Error(Status::io_error, str_cat(folder.string(), ": cannot list the folder: ", ec.message()));
+    for (; it != end; it.increment(ec)) {
+        if (ec) throw Error(Status::io_error, str_cat(folder.string(), ": cannot list the folder: ", ec.message()));
+        const std::string name = it->path().filename().string();
+        if (!name.empty() && name[0] == '.') {
+            if (it->is_directory(ec)) it.disable_recursion_pending();
+            continue;
+        }
+        if (it->is_regular_file(ec) && !is_dicomdir_name(it->path())) files.push_back(it->path());
+    }
+    std::sort(files.begin(), files.end());
+    return files;
+}
+
+/// The files of a folder taken as DICOM: the "DICM" mark, or a DICOM extension (files written
+/// without the preamble).
+[[maybe_unused]] std::vector<fs::path> folder_dicom_files(const fs::path& folder)
+{
+    std::vector<fs::path> out;
+    for (const fs::path& file : folder_files(folder)) {
+        if (dicom_extension(file) || has_dicom_mark(file_head(file))) out.push_back(file);
+    }
+    return out;
+}
+
+} // namespace
+
+bool looks_like_dicom(const fs::path& path)
+{
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+        try {
+            for (const fs::path& file : folder_files(path)) {
+                if (dicom_extension(file) || is_dicomdir_name(file) || has_dicom_mark(file_head(file))) return true;
+            }
+        } catch (const Error&) {
+        }
+        return false;
+    }
+    return has_dicom_mark(file_head(path));
+}
+
+ImageInput image_input(const fs::path& path)
+{
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) {
+        if (looks_like_dicom(path)) return ImageInput::dicom;
+        if (looks_like_tiff(path)) return ImageInput::tiff;
+        return ImageInput::empty_folder;
+    }
+    if (is_dicomdir_name(path) && fs::is_regular_file(path, ec)) return ImageInput::dicom;
+    const std::string head = file_head(path);
+    if (has_dicom_mark(head)) return ImageInput::dicom;
+    if (has_tiff_mark(head)) return ImageInput::tiff;
+    return ImageInput::none;
+}
+
+std::optional<Volume> read_image_input(const fs::path& path, const ReadOptions& options)
+{
+    switch (image_input(path)) {
+    case ImageInput::dicom: return read_dicom(path, options);
+    case ImageInput::tiff: return read_tiff(path, options);
+    case ImageInput::empty_folder:
+        throw Error(Status::unsupported_format,
+                    path.string() + ": a folder without DICOM files (the \"DICM\" mark, *.dcm) or TIFF slices (*.tif, *.tiff); "
+                                    "expected a DICOM series, a DICOMDIR, a folder of TIFF slices, or a volume file");
+    case ImageInput::none: break;
+    }
+    return std::nullopt;
+}
+
+std::optional<std::vector<fs::path>> image_input_files(const fs::path& path)
+{
+    try {
+        switch (image_input(path)) {
+        case ImageInput::dicom: return dicom_input_files(path);
+        case ImageInput::tiff: return tiff_input_files(path);
+        case ImageInput::empty_folder: return std::vector<fs::path>{path};
+        case ImageInput::none: break;
+        }
+    } catch (const std::exception&) {
+        return std::vector<fs::path>{path};
+    }
+    return std::nullopt;
+}
+
+#if !CMC33_WITH_GDCM
+
+bool dicom_supported() noexcept { return false; }
+
+namespace {
+[[noreturn]] void no_dicom(const std::string& label)
+{
+    throw Error(Status::unsupported_format,
+                label + ": DICOM input, but this build of cmc33 has no DICOM reader (built without GDCM); "
+                        "convert the series to NRRD or NIfTI, or use a build with GDCM");
+}
+} // namespace
+
+Volume read_dicom(const fs::path& path, const ReadOptions&) { no_dicom(path.string()); }
+Volume read_dicom_memory(std::string_view, const std::string& label, const ReadOptions&) { no_dicom(label); }
+std::vector<DicomSeries> list_dicom_series(const fs::path& path) { no_dicom(path.string()); }
+std::vector<fs::path> dicom_input_files(const fs::path& path) { return {path}; }
+
+#else
+
+bool dicom_supported() noexcept { return true; }
+
+namespace {
+
+// ---- tags -----------------------------------------------------------------------------------
+
+const gdcm::Tag kTransferSyntaxTag(0x0002, 0x0010);
+const gdcm::Tag kMediaStorageTag(0x0002, 0x0002);
+const gdcm::Tag kModality(0x0008, 0x0060);
+const gdcm::Tag kSeriesDescription(0x0008, 0x103e);
+const gdcm::Tag kSeriesUid(0x0020, 0x000e);
+const gdcm::Tag kInstanceNumber(0x0020, 0x0013);
+const gdcm::Tag kPosition(0x0020, 0x0032);    // ImagePositionPatient
+const gdcm::Tag kOrientation(0x0020, 0x0037); // ImageOrientationPatient
+const gdcm::Tag kSamplesPerPixel(0x0028, 0x0002);
+const gdcm::Tag kPhotometric(0x0028, 0x0004);
+const gdcm::Tag kNumberOfFrames(0x0028, 0x0008);
+const gdcm::Tag kRows(0x0028, 0x0010);
+const gdcm::Tag kColumns(0x0028, 0x0011);
+const gdcm::Tag kPixelSpacing(0x0028, 0x0030);
+const gdcm::Tag kImagerPixelSpacing(0x0018, 0x1164);
+const gdcm::Tag kBitsAllocated(0x0028, 0x0100);
+const gdcm::Tag kBitsStored(0x0028, 0x0101);
+const gdcm::Tag kHighBit(0x0028, 0x0102);
+const gdcm::Tag kPixelRepresentation(0x0028, 0x0103);
+const gdcm::Tag kIntercept(0x0028, 0x1052);
+const gdcm::Tag kSlope(0x0028, 0x1053);
+const gdcm::Tag kSharedGroups(0x5200, 0x9229);
+const gdcm::Tag kPerFrameGroups(0x5200, 0x9230);
+const gdcm::Tag kPlanePositionSeq(0x0020, 0x9113);
+const gdcm::Tag kPlaneOrientationSeq(0x0020, 0x9116);
+const gdcm::Tag kPixelMeasuresSeq(0x0028, 0x9110);
+const gdcm::Tag kValueTransformSeq(0x0028, 0x9145);
+const gdcm::Tag kPixelData(0x7fe0, 0x0010);
+const gdcm::Tag kFloatPixelData(0x7fe0, 0x0008);
+const gdcm::Tag kDoubleFloatPixelData(0x7fe0, 0x0009);
+const gdcm::Tag kDirectoryRecords(0x0004, 0x1220);
+const gdcm::Tag kReferencedFileId(0x0004, 0x1500);
+
+constexpr std::string_view kDicomdirClass = "1.2.840.10008.1.3.10";
+
+/// GDCM's own warnings and errors go to stderr unless turned off: ours say it in one line.
+void quiet_gdcm()
+{
+    static const bool done = [] {
+        gdcm::Trace::SetDebug(false);
+        gdcm::Trace::SetWarning(false);
+        gdcm::Trace::SetError(false);
+        return true;
+    }();
+    (void)done;
+}
+
+// ---- values ---------------------------------------------------------------------------------
+
+/// The bytes of a value ("" for a missing or empty one, or a sequence).
+std::string_view raw_value(const gdcm::DataSet& ds, const gdcm::Tag& tag)
+{
+    if (!ds.FindDataElement(tag)) return {};
+    const gdcm::DataElement& de = ds.GetDataElement(tag);
+    const gdcm::ByteValue* bv = de.GetByteValue();
+    if (!bv || !bv->GetPointer()) return {};
+    return std::string_view(bv->GetPointer(), bv->GetLength());
+}
+
+/// A text value without its padding (blanks and NULs).
+std::string text_value(const gdcm::DataSet& ds, const gdcm::Tag& tag)
+{
+    std::string_view v = raw_value(ds, tag);
+    while (!v.empty() && (v.back() == '\0' || v.back() == ' ')) v.remove_suffix(1);
+    while (!v.empty() && v.front() == ' ') v.remove_prefix(1);
+    return std::string(v);
+}
+
+/// The numbers of a DS or IS value ("a\b\c"); nullopt when any is not a finite number.
+std::optional<std::vector<double>> numbers_value(const gdcm::DataSet& ds, const gdcm::Tag& tag)
+{
+    const std::string text = text_value(ds, tag);
+    if (text.empty()) return std::nullopt;
+    std::vector<double> out;
+    std::size_t start = 0;
+    while (true) {
+        const std::size_t stop = text.find('\\', start);
+        const std::string_view word = trim(std::string_view(text).substr(start, stop == std::string::npos ? std::string::npos : stop - start));
+        double v = 0;
+        if (!parse_real(word, v) || !std::isfinite(v)) return std::nullopt;
+        out.push_back(v);
+        if (stop == std::string::npos) break;
+        start = stop + 1;
+    }
+    return out;
+}
+
+/// An unsigned short (US) value. GDCM holds binary values in little-endian order, whatever the
+/// transfer syntax (it swaps those of Explicit VR Big Endian as it reads them).
+std::optional<unsigned> us_value(const gdcm::DataSet& ds, const gdcm::Tag& tag)
+{
+    const std::string_view v = raw_value(ds, tag);
+    if (v.size() != 2) return std::nullopt;
+    const auto b0 = static_cast<unsigned char>(v[0]), b1 = static_cast<unsigned char>(v[1]);
+    return unsigned{b1} << 8 | b0;
+}
+
+/// The first item's data set of a sequence, or nullptr.
+const gdcm::DataSet* first_item(const gdcm::DataSet& ds, const gdcm::Tag& tag,
+                                std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>>& keep)
+{
+    if (!ds.FindDataElement(tag)) return nullptr;
+    gdcm::SmartPointer<gdcm::SequenceOfItems> sq = ds.GetDataElement(tag).GetValueAsSQ();
+    if (!sq || sq->GetNumberOfItems() < 1) return nullptr;
+    keep.push_back(sq);
+    return &sq->GetItem(1).GetNestedDataSet();
+}
+
+std::string vec_text(const Vec3& v)
+{
+    return str_cat("(", format_real(v[0]), ", ", format_real(v[1]), ", ", format_real(v[2]), ")");
+}
+
+// ---- headers --------------------------------------------------------------------------------
+
+/// Where a frame lies and how its values map to the modality's units.
+struct Geometry {
+    std::optional<Vec3> position;                 // ImagePositionPatient
+    std::optional<std::array<double, 6>> orientation; // ImageOrientationPatient: row then column cosine
+    std::optional<std::array<double, 2>> pixel_spacing; // PixelSpacing: between rows, between columns
+    double slope = 1, intercept = 0;
+};
+
+/// What a file's header says.
+struct Header {
+    std::size_t source = 0; // index in the input's file list
+    std::string label;
+    std::string transfer_uid;
+    gdcm::TransferSyntax ts;
+    std::string series, description, modality, photometric;
+    std::string instance;
+    unsigned rows = 0, columns = 0, bits_allocated = 0, bits_stored = 0, high_bit = 0, representation = 0,
+             samples_per_pixel = 1;
+    bool has_pixels = false, float_pixels = false;
+    std::int64_t frames = 1;
+    std::vector<Geometry> geometry; // one per frame
+    std::optional<std::uint64_t> native_offset; // native transfer syntaxes: the first sample's byte
+};
+
+/// One input file: a path, or bytes in memory.
+struct Source {
+    fs::path path;
+    std::string_view bytes;
+    bool in_memory = false;
+    std::string label;
+};
+
+void read_geometry(const gdcm::DataSet& ds, Geometry& g)
+{
+    if (auto p = numbers_value(ds, kPosition); p && p->size() == 3) g.position = Vec3{(*p)[0], (*p)[1], (*p)[2]};
+    if (auto o = numbers_value(ds, kOrientation); o && o->size() == 6) {
+        std::array<double, 6> a{};
+        std::copy(o->begin(), o->end(), a.begin());
+        g.orientation = a;
+    }
+    if (auto s = numbers_value(ds, kPixelSpacing); s && s->size() == 2) g.pixel_spacing = std::array<double, 2>{(*s)[0], (*s)[1]};
+    if (auto s = numbers_value(ds, kSlope); s && s->size() == 1) g.slope = (*s)[0];
+    if (auto s = numbers_value(ds, kIntercept); s && s->size() == 1) g.intercept = (*s)[0];
+}
+
+/// Fills `g` from a functional groups item (Enhanced CT/MR, PS3.3 C.7.6.16): what the item has
+/// replaces what `g` holds.
+void read_functional_groups(const gdcm::DataSet& item, Geometry& g)
+{
+    std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep;
+    if (const gdcm::DataSet* ds = first_item(item, kPlanePositionSeq, keep)) {
+        Geometry h;
+        read_geometry(*ds, h);
+        if (h.position) g.position = h.position;
+    }
+    if (const gdcm::DataSet* ds = first_item(item, kPlaneOrientationSeq, keep)) {
+        Geometry h;
+        read_geometry(*ds, h);
+        if (h.orientation) g.orientation = h.orientation;
+    }
+    if (const gdcm::DataSet* ds = first_item(item, kPixelMeasuresSeq, keep)) {
+        Geometry h;
+        read_geometry(*ds, h);
+        if (h.pixel_spacing) g.pixel_spacing = h.pixel_spacing;
+    }
+    if (const gdcm::DataSet* ds = first_item(item, kValueTransformSeq, keep)) {
+        if (ds->FindDataElement(kSlope) || ds->FindDataElement(kIntercept)) {
+            Geometry h;
+            read_geometry(*ds, h);
+            g.slope = h.slope;
+            g.intercept = h.intercept;
+        }
+    }
+}
+
+/// Opens a GDCM reader on a source. The stream must outlive the reader's use.
+void open(gdcm::Reader& reader, const Source& source, std::unique_ptr<std::istringstream>& stream)
+{
+    if (source.in_memory) {
+        stream = std::make_unique<std::istringstream>(std::string(source.bytes));
+        reader.SetStream(*stream);
+    } else {
+        reader.SetFileName(source.path.c_str());
+    }
+}
+
+bool is_native(const gdcm::TransferSyntax& ts)
+{
+    return ts == gdcm::TransferSyntax::ImplicitVRLittleEndian || ts == gdcm::TransferSyntax::ExplicitVRLittleEndian ||
+           ts == gdcm::TransferSyntax::ExplicitVRBigEndian;
+}
+
+/// The bytes of a source from `offset` (at most `count`).
+std::string source_bytes(const Source& source, std::uint64_t offset, std::uint64_t count)
+{
+    if (source.in_memory) {
+        if (offset >= source.bytes.size()) return {};
+        return std::string(source.bytes.substr(static_cast<std::size_t>(offset), static_cast<std::size_t>(count)));
+    }
+    const InputFile file(source.path, source.label);
+    return file.read_string(offset, count);
+}
+
+/// Reads a file's header up to its Pixel Data (GDCM reads no further).
+Header read_header(const Source& source, std::size_t index)
+{
+    quiet_gdcm();
+    Header h;
+    h.source = index;
+    h.label = source.label;
+    gdcm::Reader reader;
+    std::unique_ptr<std::istringstream> stream;
+    open(reader, source, stream);
+    bool ok = false;
+    try {
+        ok = reader.ReadUpToTag(kPixelData);
+    } catch (const std::exception&) {
+        ok = false;
+    }
+    if (!ok) {
+        throw Error(Status::bad_format, source.label + ": not a DICOM file GDCM can read (expected a DICOM Part 10 "
+                                                       "file: a 128-byte preamble, \"DICM\", then the data set)");
+    }
+    const gdcm::File& file = reader.GetFile();
+    const gdcm::DataSet& meta = file.GetHeader();
+    const gdcm::DataSet& ds = file.GetDataSet();
+    h.ts = file.GetHeader().GetDataSetTransferSyntax();
+    h.transfer_uid = text_value(meta, kTransferSyntaxTag);
+    if (text_value(meta, kMediaStorageTag) == kDicomdirClass) {
+        h.modality = "DICOMDIR";
+        return h;
+    }
+    h.series = text_value(ds, kSeriesUid);
+    h.description = text_value(ds, kSeriesDescription);
+    h.modality = text_value(ds, kModality);
+    h.instance = text_value(ds, kInstanceNumber);
+    h.photometric = text_value(ds, kPhotometric);
+    h.has_pixels = ds.FindDataElement(kPixelData);
+    h.float_pixels = ds.FindDataElement(kFloatPixelData) || ds.FindDataElement(kDoubleFloatPixelData);
+    if (h.has_pixels && is_native(h.ts)) {
+        // GDCM stops after the Pixel Data element, its value skipped: the samples are the `length`
+        // bytes before that point, if the element's own header says so (else GDCM reads them).
+        const gdcm::VL vl = ds.GetDataElement(kPixelData).GetVL();
+        const std::uint64_t end = reader.GetStreamCurrentPosition();
+        const bool explicit_vr = h.ts != gdcm::TransferSyntax::ImplicitVRLittleEndian;
+        const bool big = h.ts == gdcm::TransferSyntax::ExplicitVRBigEndian;
+        const std::uint64_t length = static_cast<std::uint32_t>(vl), header = explicit_vr ? 12 : 8;
+        if (!vl.IsUndefined() && end >= length + header) {
+            const std::string head = source_bytes(source, end - length - header, header);
+            const auto byte = [&](std::size_t i) { return static_cast<std::uint32_t>(static_cast<unsigned char>(head[i])); };
+            const bool tag_ok = head.size() == header && (big ? head.compare(0, 4, "\x7f\xe0\x00\x10", 4) == 0
+                                                              : head.compare(0, 4, "\xe0\x7f\x10\x00", 4) == 0);
+            const std::size_t at = header - 4;
+            const std::uint32_t stored = !tag_ok ? 0
+                                         : big  ? byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3)
+                                                : byte(at + 3) << 24 | byte(at + 2) << 16 | byte(at + 1) << 8 | byte(at);
+            if (tag_ok && stored == length) h.native_offset = end - length;
+        }
+    }
+    if (!h.has_pixels && !h.float_pixels) {
+        // a reader that stops before the Pixel Data: its presence shows in the bytes that follow
+        const std::uint64_t at = reader.GetStreamCurrentPosition();
+        const std::string tag = source_bytes(source, at, 4);
+        h.has_pixels = tag == std::string("\xe0\x7f\x10\x00", 4) || tag == std::string("\x7f\xe0\x00\x10", 4);
+        h.float_pixels = tag == std::string("\xe0\x7f\x08\x00", 4) || tag == std::string("\xe0\x7f\x09\x00", 4);
+    }
+    h.rows = us_value(ds, kRows).value_or(0);
+    h.columns = us_value(ds, kColumns).value_or(0);
+    h.bits_allocated = us_value(ds, kBitsAllocated).value_or(0);
+    h.bits_stored = us_value(ds, kBitsStored).value_or(h.bits_allocated);
+    h.high_bit = us_value(ds, kHighBit).value_or(h.bits_stored > 0 ? h.bits_stored - 1 : 0);
+    h.representation = us_value(ds, kPixelRepresentation).value_or(0);
+    h.samples_per_pixel = us_value(ds, kSamplesPerPixel).value_or(1);
+    // Where the bytes after the header do not show the Pixel Data tag (a deflated data set), an
+    // image's attributes say there is one; GDCM's decoder then reads it.
+    if (!h.has_pixels && !h.float_pixels && h.rows > 0 && h.columns > 0 && h.bits_allocated > 0) h.has_pixels = true;
+    if (auto n = numbers_value(ds, kNumberOfFrames); n && n->size() == 1) {
+        const double f = (*n)[0];
+        if (!(f >= 1 && f <= 1e9 && f == std::floor(f))) {
+            throw Error(Status::bad_format, str_cat(source.label, ": NumberOfFrames ", text_value(ds, kNumberOfFrames),
+                                                    " is not a whole number >= 1"));
+        }
+        h.frames = static_cast<std::int64_t>(f);
+    }
+    Geometry top;
+    read_geometry(ds, top);
+    if (!top.pixel_spacing) {
+        if (auto s = numbers_value(ds, kImagerPixelSpacing); s && s->size() == 2)
+            top.pixel_spacing = std::array<double, 2>{(*s)[0], (*s)[1]};
+    }
+    std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep;
+    if (const gdcm::DataSet* shared = first_item(ds, kSharedGroups, keep)) read_functional_groups(*shared, top);
+    gdcm::SmartPointer<gdcm::SequenceOfItems> per_frame;
+    if (ds.FindDataElement(kPerFrameGroups)) per_frame = ds.GetDataElement(kPerFrameGroups).GetValueAsSQ();
+    if (per_frame && per_frame->GetNumberOfItems() > 0) {
+        if (static_cast<std::int64_t>(per_frame->GetNumberOfItems()) != h.frames) {
+            throw Error(Status::bad_format,
+                        str_cat(source.label, ": PerFrameFunctionalGroupsSequence has ", per_frame->GetNumberOfItems(),
+                                " items but NumberOfFrames is ", h.frames, "; expected one item per frame"));
+        }
+        h.geometry.reserve(static_cast<std::size_t>(h.frames));
+        for (std::size_t f = 1; f <= per_frame->GetNumberOfItems(); ++f) {
+            Geometry g = top;
+            read_functional_groups(per_frame->GetItem(f).GetNestedDataSet(), g);
+            h.geometry.push_back(g);
+        }
+    } else if (h.frames == 1) {
+        h.geometry.push_back(top);
+    } else {
+        // a multi-frame file without per-frame positions: the frames cannot be placed
+        h.geometry.assign(static_cast<std::size_t>(h.frames), Geometry{std::nullopt, top.orientation, top.pixel_spacing,
+                                                                      top.slope, top.intercept});
+    }
+    return h;
+}
+
+// ---- slices ---------------------------------------------------------------------------------
+
+/// One z slice: a frame of a file.
+struct Slice {
+    const Header* header = nullptr;
+    std::int64_t frame = 0;
+    const Geometry* geometry = nullptr;
+    double key = 0; // position along the slice normal
+
+    std::string name() const
+    {
+        if (header->frames > 1) return str_cat(header->label, ": frame ", frame + 1);
+        return header->label;
+    }
+};
+
+std::string series_summary(const std::vector<const Header*>& files)
+{
+    const Header& h = *files.front();
+    std::int64_t slices = 0;
+    for (const Header* f : files) slices += f->frames;
+    std::string s = h.series.empty() ? std::string("(no SeriesInstanceUID)") : h.series;
+    s += " (";
+    if (!h.modality.empty()) s += h.modality + " ";
+    if (!h.description.empty()) s += quote_bytes(h.description, 64) + " ";
+    s += str_cat(h.columns, "x", h.rows, "x", slices, ")");
+    return s;
+}
+
+/// The files of one series, in the input's order.
+using SeriesMap = std::map<std::string, std::vector<const Header*>>;
+
+SeriesMap group_series(const std::vector<Header>& headers)
+{
+    SeriesMap map;
+    for (const Header& h : headers) {
+        if (h.has_pixels || h.float_pixels) map[h.series].push_back(&h);
+    }
+    return map;
+}
+
+const std::vector<const Header*>& choose_series(const SeriesMap& map, const std::string& label, const ReadOptions& options)
+{
+    if (map.empty()) {
+        throw Error(Status::bad_format, label + ": no DICOM image (no file with Pixel Data); expected the slice files of a series");
+    }
+    std::string list;
+    for (const auto& [uid, files] : map) {
+        if (!list.empty()) list += ", ";
+        list += series_summary(files);
+    }
+    if (!options.series.empty()) {
+        const auto it = map.find(options.series);
+        if (it == map.end()) {
+            throw Error(Status::invalid_argument,
+                        str_cat(label, ": no series ", quote_bytes(options.series, 80), "; the input holds ", map.size(),
+                                map.size() == 1 ? " series: " : " series: ", list));
+        }
+        return it->second;
+    }
+    if (map.size() > 1) {
+        throw Error(Status::bad_format, str_cat(label, ": ", map.size(), " DICOM series; choose one with --series UID: ", list));
+    }
+    return map.begin()->second;
+}
+
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b)
+{
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+/// Cosines are written with a few digits (often 6): directions within this are the same.
+constexpr double kCosineTolerance = 1e-4;
+
+/// The checks on the series' files: one sample layout, one orientation, positions for all.
+void check_uniform(const std::vector<const Header*>& files, const std::string& label)
+{
+    const Header& a = *files.front();
+    for (const Header* f : files) {
+        if (f->float_pixels) {
+            throw Error(Status::unsupported_format,
+                        f->label + ": Float Pixel Data (parametric maps) is not read; expected integer Pixel Data");
+        }
+        if (f->samples_per_pixel != 1) {
+            throw Error(Status::unsupported_format,
+                        str_cat(f->label, ": ", f->samples_per_pixel, " samples per pixel (", f->photometric.empty() ? "color" : f->photometric,
+                                "); expected one sample per pixel (MONOCHROME1 or MONOCHROME2), a scalar volume"));
+        }
+        if (f->rows != a.rows || f->columns != a.columns) {
+            throw Error(Status::bad_format, str_cat(label, ": mixed slice sizes in one series: ", a.label, " has ", a.columns, "x",
+                                                    a.rows, " (columns x rows), ", f->label, " has ", f->columns, "x", f->rows));
+        }
+        if (f->bits_allocated != a.bits_allocated || f->representation != a.representation || f->bits_stored != a.bits_stored) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": mixed pixel types in one series: ", a.label, " has ", a.bits_allocated, " bits allocated, ",
+                                a.bits_stored, " stored, ", a.representation ? "signed" : "unsigned", "; ", f->label, " has ",
+                                f->bits_allocated, ", ", f->bits_stored, ", ", f->representation ? "signed" : "unsigned"));
+        }
+    }
+    if (a.rows < 2 || a.columns < 2) {
+        throw Error(Status::bad_format, str_cat(a.label, ": ", a.columns, "x", a.rows,
+                                                " pixels (columns x rows); an isosurface needs at least 2 on each axis"));
+    }
+    if (a.bits_allocated != 8 && a.bits_allocated != 16 && a.bits_allocated != 32) {
+        throw Error(Status::unsupported_format, str_cat(a.label, ": BitsAllocated ", a.bits_allocated, "; expected 8, 16 or 32"));
+    }
+    if (a.bits_stored < 1 || a.bits_stored > a.bits_allocated || a.high_bit >= a.bits_allocated ||
+        a.high_bit + 1 < a.bits_stored) {
+        throw Error(Status::bad_format, str_cat(a.label, ": BitsStored ", a.bits_stored, " with HighBit ", a.high_bit,
+                                                " does not fit BitsAllocated ", a.bits_allocated));
+    }
+    if (a.representation > 1) {
+        throw Error(Status::bad_format,
+                    str_cat(a.label, ": PixelRepresentation ", a.representation, "; expected 0 (unsigned) or 1 (signed)"));
+    }
+}
+
+/// The slices of the series sorted along their normal, with the checks on their positions.
+/// Returns the slices and sets `grid`'s frame.
+std::vector<Slice> sort_slices(const std::vector<const Header*>& files, const std::string& label, Grid& grid)
+{
+    std::vector<Slice> slices;
+    for (const Header* f : files) {
+        for (std::int64_t k = 0; k < f->frames; ++k) {
+            const Geometry& g = f->geometry[static_cast<std::size_t>(k)];
+            Slice s{f, k, &g, 0};
+            if (!g.position || !g.orientation) {
+                throw Error(Status::bad_format,
+                            str_cat(s.name(), ": no ", !g.position ? "ImagePositionPatient" : "ImageOrientationPatient",
+                                    " (or not 3 and 6 numbers); the slices cannot be placed in space without it"));
+            }
+            slices.push_back(s);
+        }
+    }
+    if (slices.size() < 2) {
+        throw Error(Status::bad_format,
+                    str_cat(label, ": the series has 1 slice (", slices.front().name(),
+                            "); an isosurface needs at least 2: give the folder of the series' slice files"));
+    }
+    const std::array<double, 6>& o = *slices.front().geometry->orientation;
+    const Vec3 row{o[0], o[1], o[2]}, col{o[3], o[4], o[5]};
+    for (const Slice& s : slices) {
+        const std::array<double, 6>& p = *s.geometry->orientation;
+        for (std::size_t i = 0; i < 6; ++i) {
+            if (std::fabs(p[i] - o[i]) > kCosineTolerance) {
+                throw Error(Status::bad_format,
+                            str_cat(label, ": mixed orientations in one series: ", slices.front().name(), " has ImageOrientationPatient ",
+                                    format_real(o[0]), "\\", format_real(o[1]), "\\", format_real(o[2]), "\\", format_real(o[3]), "\\",
+                                    format_real(o[4]), "\\", format_real(o[5]), ", ", s.name(), " has ", format_real(p[0]), "\\",
+                                    format_real(p[1]), "\\", format_real(p[2]), "\\", format_real(p[3]), "\\", format_real(p[4]), "\\",
+                                    format_real(p[5])));
+            }
+        }
+    }
+    const double nr = std::sqrt(dot(row, row)), nc = std::sqrt(dot(col, col));
+    Vec3 normal = cross(row, col);
+    const double nn = std::sqrt(dot(normal, normal));
+    if (!(std::fabs(nr - 1) < 0.01 && std::fabs(nc - 1) < 0.01 && nn > 0.99)) {
+        throw Error(Status::bad_format,
+                    str_cat(slices.front().name(), ": ImageOrientationPatient's row ", vec_text(row), " and column ", vec_text(col),
+                            " cosines are not two orthogonal unit vectors"));
+    }
+    for (double& v : normal) v /= nn;
+    for (Slice& s : slices) s.key = dot(normal, *s.geometry->position);
+    std::stable_sort(slices.begin(), slices.end(), [](const Slice& a, const Slice& b) { return a.key < b.key; });
+
+    // The step between slices: the median of the steps (robust to a gap), then each checked.
+    const std::size_t n = slices.size();
+    std::vector<double> steps(n - 1);
+    for (std::size_t k = 0; k + 1 < n; ++k) steps[k] = slices[k + 1].key - slices[k].key;
+    std::vector<double> sorted = steps;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2), sorted.end());
+    const double step = sorted[sorted.size() / 2];
+    // Positions are written in mm with a few decimals; a slice this close to another one is the
+    // same position, and one off the regular grid by more than 1% of a step is irregular.
+    const double tolerance = std::max(1e-4, 0.01 * std::fabs(step));
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+        if (std::fabs(steps[k]) <= tolerance) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": duplicate slice position ", vec_text(*slices[k].geometry->position), ": ", slices[k].name(),
+                                " and ", slices[k + 1].name(), " (one position per slice expected; two acquisitions in one series?)"));
+        }
+    }
+    for (std::size_t k = 0; k + 1 < n; ++k) {
+        const double ratio = steps[k] / step;
+        if (std::fabs(steps[k] - step) <= tolerance) continue;
+        const double whole = std::round(ratio);
+        if (whole >= 2 && std::fabs(steps[k] - whole * step) <= tolerance) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": missing slice", whole > 2 ? "s" : "", ": ", static_cast<long long>(whole) - 1,
+                                " between ", slices[k].name(), " at ", format_real(slices[k].key), " mm and ", slices[k + 1].name(),
+                                " at ", format_real(slices[k + 1].key), " mm along the slice normal (the step elsewhere is ",
+                                format_real(step), " mm)"));
+        }
+        throw Error(Status::bad_format,
+                    str_cat(label, ": non-uniform slice spacing: ", format_real(steps[k]), " mm between ", slices[k].name(), " at ",
+                            format_real(slices[k].key), " mm and ", slices[k + 1].name(), " at ", format_real(slices[k + 1].key),
+                            " mm along the slice normal, ", format_real(step), " mm elsewhere; expected evenly spaced slices"));
+    }
+    // The slice axis: from the first to the last position (a gantry tilt makes it oblique to the
+    // normal: a sheared frame); every slice must lie on it.
+    const Vec3 p0 = *slices.front().geometry->position, p1 = *slices.back().geometry->position;
+    const double last = static_cast<double>(n - 1);
+    const Vec3 axis{(p1[0] - p0[0]) / last, (p1[1] - p0[1]) / last, (p1[2] - p0[2]) / last};
+    for (std::size_t k = 1; k + 1 < n; ++k) {
+        const Vec3& p = *slices[k].geometry->position;
+        const double t = static_cast<double>(k);
+        const Vec3 d{p[0] - p0[0] - t * axis[0], p[1] - p0[1] - t * axis[1], p[2] - p0[2] - t * axis[2]};
+        if (std::sqrt(dot(d, d)) > tolerance) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": ", slices[k].name(), " at ", vec_text(p), " is ", format_real(std::sqrt(dot(d, d))),
+                                " mm off the line from the first slice ", vec_text(p0), " to the last ", vec_text(p1),
+                                "; expected the slices on one straight line"));
+        }
+    }
+    std::array<double, 2> ps{1, 1};
+    if (const auto& s = slices.front().geometry->pixel_spacing) ps = *s;
+    for (const Slice& s : slices) {
+        const auto& q = s.geometry->pixel_spacing;
+        if (q && (std::fabs((*q)[0] - ps[0]) > 1e-6 * ps[0] || std::fabs((*q)[1] - ps[1]) > 1e-6 * ps[1])) {
+            throw Error(Status::bad_format,
+                        str_cat(label, ": mixed PixelSpacing in one series: ", slices.front().name(), " has ", format_real(ps[0]), "\\",
+                                format_real(ps[1]), ", ", s.name(), " has ", format_real((*q)[0]), "\\", format_real((*q)[1])));
+        }
+    }
+    if (!(ps[0] > 0 && ps[1] > 0)) {
+        throw Error(Status::bad_format, str_cat(slices.front().name(), ": PixelSpacing ", format_real(ps[0]), "\\", format_real(ps[1]),
+                                                " is not positive; expected the distances between rows and between columns"));
+    }
+    // PS3.3 C.7.6.2.1.1: the first cosine is the direction of a row (increasing column index i,
+    // our x), the second that of a column (increasing row index j, our y); PixelSpacing is the
+    // row spacing (between rows, along y) then the column spacing (between columns, along x).
+    set_frame(grid, {row, col, axis}, {ps[1], ps[0], 1}, label, "ImageOrientationPatient and ImagePositionPatient");
+    // the cosines are unit vectors written with a few digits: the spacing is PixelSpacing's own
+    grid.spacing[0] = ps[1];
+    grid.spacing[1] = ps[0];
+    grid.origin = p0;
+    grid.space = "left-posterior-superior";
+    grid.dims = {static_cast<std::int64_t>(slices.front().header->columns), static_cast<std::int64_t>(slices.front().header->rows),
+                 static_cast<std::int64_t>(n)};
+    return slices;
+}
+
+// ---- samples --------------------------------------------------------------------------------
+
+ScalarType stored_type(const Header& h)
+{
+    const bool s = h.representation == 1;
+    switch (h.bits_allocated) {
+    case 8: return s ? ScalarType::i8 : ScalarType::u8;
+    case 16: return s ? ScalarType::i16 : ScalarType::u16;
+    default: return s ? ScalarType::i32 : ScalarType::u32;
+    }
+}
+
+/// Keeps the BitsStored bits below HighBit (PS3.5 8.1.1), sign-extended when signed: the bits
+/// above may hold overlays or garbage.
+template <class T> void clean_bits(T* data, std::size_t count, const Header& h)
+{
+    using U = std::make_unsigned_t<T>;
+    const unsigned width = 8 * sizeof(T);
+    if (h.bits_stored == width) return;
+    const unsigned shift = h.high_bit + 1 - h.bits_stored;
+    const U mask = static_cast<U>((U{1} << h.bits_stored) - 1);
+    const U sign = static_cast<U>(U{1} << (h.bits_stored - 1));
+    for (std::size_t i = 0; i < count; ++i) {
+        U v = static_cast<U>((static_cast<U>(data[i]) >> shift) & mask);
+        if (std::is_signed_v<T> && (v & sign)) v = static_cast<U>(v | static_cast<U>(~mask));
+        data[i] = static_cast<T>(v);
+    }
+}
+
+/// Reads every slice's stored samples into `out` (slice k at k * slice_bytes).
+void read_stored(const std::vector<Slice>& slices, const std::vector<Source>& sources, std::byte* out,
+                 std::size_t slice_bytes, ScalarType type)
+{
+    // files read through GDCM's decoders, decoded once for all their frames
+    std::map<const Header*, std::vector<char>> decoded;
+    std::unique_ptr<InputFile> open_file;
+    const Header* open_header = nullptr;
+    for (std::size_t k = 0; k < slices.size(); ++k) {
+        const Slice& s = slices[k];
+        const Header& h = *s.header;
+        const Source& src = sources[h.source];
+        std::byte* dst = out + k * slice_bytes;
+        const std::uint64_t frame_offset = static_cast<std::uint64_t>(s.frame) * slice_bytes;
+        if (h.native_offset) {
+            const std::uint64_t at = *h.native_offset + frame_offset;
+            if (src.in_memory) {
+                if (at > src.bytes.size() || src.bytes.size() - at < slice_bytes) {
+                    throw Error(Status::truncated_file, str_cat(s.name(), ": the Pixel Data ends before the frame's ", slice_bytes,
+                                                                " bytes (file cut short?)"));
+                }
+                std::memcpy(dst, src.bytes.data() + at, slice_bytes);
+            } else {
+                if (open_header != &h) {
+                    open_file = std::make_unique<InputFile>(src.path, src.label);
+                    open_header = &h;
+                }
+                if (at > open_file->size() || open_file->size() - at < slice_bytes) {
+                    throw Error(Status::truncated_file,
+                                str_cat(s.name(), ": the Pixel Data holds fewer than the ", h.frames * static_cast<std::int64_t>(slice_bytes),
+                                        " bytes of ", h.frames, " frame", h.frames == 1 ? "" : "s", " of ", h.columns, "x", h.rows, " ",
+                                        type_name(type), " samples (file cut short?)"));
+                }
+                open_file->read(at, dst, slice_bytes);
+            }
+            to_native(dst, slice_bytes / type_size(type), type_size(type),
+                      h.ts == gdcm::TransferSyntax::ExplicitVRBigEndian ? Endian::big : Endian::little);
+            continue;
+        }
+        auto it = decoded.find(&h);
+        if (it == decoded.end()) {
+            if (!h.ts.IsValid()) {
+                throw Error(Status::unsupported_format,
+                            str_cat(h.label, ": transfer syntax ", quote_bytes(h.transfer_uid, 80),
+                                    " is not one GDCM decodes; expected a native or a JPEG, JPEG-LS, JPEG 2000 or RLE syntax"));
+            }
+            gdcm::ImageReader reader;
+            std::unique_ptr<std::istringstream> stream;
+            open(reader, src, stream);
+            bool ok = false;
+            try {
+                ok = reader.Read();
+            } catch (const std::exception&) {
+                ok = false;
+            }
+            if (!ok) throw Error(Status::bad_format, h.label + ": GDCM cannot read the image (corrupt or unsupported Pixel Data)");
+            const gdcm::Image& image = reader.GetImage();
+            const std::uint64_t want = static_cast<std::uint64_t>(h.frames) * slice_bytes;
+            const unsigned long have = image.GetBufferLength();
+            if (have != want) {
+                throw Error(Status::bad_format, str_cat(h.label, ": the decoded Pixel Data holds ", have, " bytes, expected ", want,
+                                                        " (", h.frames, " frame", h.frames == 1 ? "" : "s", " of ", h.columns, "x", h.rows,
+                                                        " ", type_name(type), " samples)"));
+            }
+            std::vector<char> buffer(static_cast<std::size_t>(want));
+            bool decoded_ok = false;
+            try {
+                decoded_ok = image.GetBuffer(buffer.data());
+            } catch (const std::exception&) {
+                decoded_ok = false;
+            }
+            if (!decoded_ok) {
+                throw Error(Status::unsupported_format,
+                            str_cat(h.label, ": GDCM cannot decode the Pixel Data of transfer syntax ", h.ts.GetString() ? h.ts.GetString() : "?",
+                                    " (", quote_bytes(h.transfer_uid, 80), ")"));
+            }
+            it = decoded.emplace(&h, std::move(buffer)).first;
+        }
+        std::memcpy(dst, it->second.data() + frame_offset, slice_bytes);
+        if (k + 1 == slices.size() || slices[k + 1].header != &h) {
+            // keep a decoded file only while later slices may still come from it
+            bool later = false;
+            for (std::size_t j = k + 1; j < slices.size() && !later; ++j) later = slices[j].header == &h;
+            if (!later) decoded.erase(it);
+        }
+    }
+}
+
+/// Samples after Rescale Slope/Intercept (PS3.3 C.11.1.1.2), in the narrowest type that holds them
+/// exactly: the stored type without rescale; int16 or int32 when slopes and intercepts are whole
+/// and the values fit; float otherwise. `samples` holds the stored samples, slice after slice;
+/// it is converted in place when the type keeps its width (the usual CT: uint16 or int16 stored,
+/// int16 Hounsfield units), else into a new buffer.
+template <class T>
+Volume rescale(std::unique_ptr<std::byte[]> samples, const Grid& grid, const std::vector<Slice>& slices)
+{
+    const auto make = [&](ScalarType type, std::unique_ptr<std::byte[]> bytes) {
+        Volume v(type, grid.dims, grid.spacing, grid.origin, std::move(bytes));
+        v.set_direction(grid.direction);
+        v.set_space(grid.space);
+        return v;
+    };
+    bool identity = true, whole = true;
+    for (const Slice& s : slices) {
+        const double m = s.geometry->slope, c = s.geometry->intercept;
+        identity = identity && m == 1 && c == 0;
+        whole = whole && m == std::round(m) && c == std::round(c) && std::fabs(m) < 1e6 && std::fabs(c) < 1e9;
+    }
+    if (identity) return make(grid.type, std::move(samples));
+    const std::int64_t plane = grid.dims[0] * grid.dims[1];
+    const T* in = reinterpret_cast<const T*>(samples.get());
+    double lo = std::numeric_limits<double>::max(), hi = std::numeric_limits<double>::lowest();
+    for (std::size_t k = 0; k < slices.size(); ++k) {
+        const T* p = in + static_cast<std::int64_t>(k) * plane;
+        T mn = p[0], mx = p[0];
+        for (std::int64_t i = 0; i < plane; ++i) { // values, not iterators: this vectorizes
+            mn = std::min(mn, p[i]);
+            mx = std::max(mx, p[i]);
+        }
+        const double a = slices[k].geometry->slope * static_cast<double>(mn) + slices[k].geometry->intercept;
+        const double b = slices[k].geometry->slope * static_cast<double>(mx) + slices[k].geometry->intercept;
+        lo = std::min({lo, a, b});
+        hi = std::max({hi, a, b});
+    }
+    ScalarType target = ScalarType::f32;
+    if (whole && lo >= -32768 && hi <= 32767) target = ScalarType::i16;
+    else if (whole && lo >= -2147483648.0 && hi <= 2147483647.0) target = ScalarType::i32;
+    const std::size_t count = static_cast<std::size_t>(plane) * slices.size();
+    const bool in_place = type_size(target) == sizeof(T);
+    std::unique_ptr<std::byte[]> out =
+        in_place ? std::move(samples) : std::make_unique_for_overwrite<std::byte[]>(count * type_size(target));
+    if (!in_place) cmc33::detail::advise_huge_pages_within(out.get(), count * type_size(target));
+    dispatch_scalar_type(target, [&](auto out_tag) {
+        using O = decltype(out_tag);
+        O* o = reinterpret_cast<O*>(out.get());
+        const T* src = in_place ? reinterpret_cast<const T*>(out.get()) : in;
+        // In place the source and the target share memory: a block is copied out first, so that
+        // the loops below see distinct arrays and vectorize.
+        constexpr std::size_t kBlock = 1024;
+        T block[kBlock];
+        for (std::size_t k = 0; k < slices.size(); ++k) {
+            const double m = slices[k].geometry->slope, c = slices[k].geometry->intercept;
+            const bool narrow = sizeof(T) <= 2 && std::fabs(m) <= 16384 && std::fabs(c) <= 536870912;
+            const auto mi = static_cast<std::int64_t>(m), ci = static_cast<std::int64_t>(c);
+            for (std::size_t at = k * static_cast<std::size_t>(plane), stop = at + static_cast<std::size_t>(plane); at < stop;) {
+                const std::size_t n = std::min(kBlock, stop - at);
+                std::memcpy(block, src + at, n * sizeof(T));
+                O* __restrict dst = o + at;
+                if constexpr (std::is_floating_point_v<O>) {
+                    for (std::size_t i = 0; i < n; ++i) dst[i] = static_cast<O>(m * static_cast<double>(block[i]) + c);
+                } else if (narrow) {
+                    // 16-bit samples times |m| <= 2^14, plus |c| <= 2^29, stay within 32 bits
+                    const auto m32 = static_cast<std::int32_t>(mi), c32 = static_cast<std::int32_t>(ci);
+                    for (std::size_t i = 0; i < n; ++i) dst[i] = static_cast<O>(m32 * static_cast<std::int32_t>(block[i]) + c32);
+                } else {
+                    for (std::size_t i = 0; i < n; ++i) dst[i] = static_cast<O>(mi * static_cast<std::int64_t>(block[i]) + ci);
+                }
+                at += n;
+            }
+        }
+        return 0;
+    });
+    return make(target, std::move(out));
+}
+
+/// The volume of one series.
+Volume build_volume(const std::vector<const Header*>& files, const std::vector<Source>& sources, const std::string& label)
+{
+    check_uniform(files, label);
+    Grid grid;
+    const std::vector<Slice> slices = sort_slices(files, label, grid);
+    const Header& first = *files.front();
+    grid.type = stored_type(first);
+    const std::uint64_t bytes = payload_bytes(grid.dims, grid.type, label);
+    const std::size_t slice_bytes = static_cast<std::size_t>(bytes / static_cast<std::uint64_t>(grid.dims[2]));
+    // a file cut short is found before allocating the volume
+    for (const Header* f : files) {
+        if (!f->native_offset) continue;
+        const Source& src = sources[f->source];
+        std::uint64_t size = 0;
+        if (src.in_memory) {
+            size = src.bytes.size();
+        } else {
+            std::error_code ec;
+            size = fs::file_size(src.path, ec);
+            if (ec) throw Error(Status::io_error, str_cat(f->label, ": cannot open: ", ec.message()));
+        }
+        const std::uint64_t need = static_cast<std::uint64_t>(f->frames) * slice_bytes;
+        if (*f->native_offset > size || size - *f->native_offset < need) {
+            throw Error(Status::truncated_file,
+                        str_cat(f->label, ": the Pixel Data should hold ", need, " bytes (", f->frames, " frame", f->frames == 1 ? "" : "s",
+                                " of ", f->columns, "x", f->rows, " ", type_name(grid.type), " samples) but the file has ",
+                                size > *f->native_offset ? size - *f->native_offset : 0, " after byte ", *f->native_offset,
+                                " (file cut short?)"));
+        }
+    }
+    // not zeroed: every byte is read into
+    std::unique_ptr<std::byte[]> samples = std::make_unique_for_overwrite<std::byte[]>(static_cast<std::size_t>(bytes));
+    cmc33::detail::advise_huge_pages_within(samples.get(), static_cast<std::size_t>(bytes)); // 2 MiB faults, not 4 KiB
+    read_stored(slices, sources, samples.get(), slice_bytes, grid.type);
+    const auto count = static_cast<std::size_t>(bytes / type_size(grid.type));
+    return dispatch_scalar_type(grid.type, [&](auto tag) -> Volume {
+        using T = decltype(tag);
+        if constexpr (std::is_floating_point_v<T>) {
+            throw Error(Status::internal, label + ": floating-point stored samples");
+        } else {
+            clean_bits(reinterpret_cast<T*>(samples.get()), count, first);
+            return rescale<T>(std::move(samples), grid, slices);
+        }
+    });
+}
+
+// ---- inputs ---------------------------------------------------------------------------------
+
+/// The files a DICOMDIR names (its directory records' ReferencedFileID, relative to its folder).
+std::vector<fs::path> dicomdir_files(const fs::path& dicomdir)
+{
+    quiet_gdcm();
+    gdcm::Reader reader;
+    reader.SetFileName(dicomdir.c_str());
+    bool ok = false;
+    try {
+        ok = reader.Read();
+    } catch (const std::exception&) {
+        ok = false;
+    }
+    if (!ok) throw Error(Status::bad_format, dicomdir.string() + ": not a DICOMDIR GDCM can read");
+    const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
+    std::vector<fs::path> files;
+    if (!ds.FindDataElement(kDirectoryRecords)) return files;
+    gdcm::SmartPointer<gdcm::SequenceOfItems> records = ds.GetDataElement(kDirectoryRecords).GetValueAsSQ();
+    if (!records) return files;
+    for (std::size_t i = 1; i <= records->GetNumberOfItems(); ++i) {
+        const std::string id = text_value(records->GetItem(i).GetNestedDataSet(), kReferencedFileId);
+        if (id.empty()) continue;
+        fs::path file = dicomdir.parent_path();
+        std::size_t start = 0;
+        while (start <= id.size()) {
+            const std::size_t stop = std::min(id.find('\\', start), id.size());
+            const std::string part(trim(std::string_view(id).substr(start, stop - start)));
+            if (!part.empty() && part != "." && part != "..") file /= part;
+            start = stop + 1;
+        }
+        std::error_code ec;
+        if (!fs::exists(file, ec)) {
+            // media are written in upper case; a copy may have been lower-cased
+            fs::path lower = dicomdir.parent_path() / lower_ascii(fs::relative(file, dicomdir.parent_path(), ec).string());
+            if (fs::exists(lower, ec)) file = lower;
+        }
+        files.push_back(file);
+    }
+    std::sort(files.begin(), files.end());
+    files.erase(std::unique(files.begin(), files.end()), files.end());
+    return files;
+}
+
+enum class InputKind { folder, dicomdir, file };
+
+InputKind input_kind(const fs::path& path)
+{
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) return InputKind::folder;
+    if (!fs::exists(path, ec)) throw Error(Status::io_error, path.string() + ": cannot open: no such file or folder");
+    if (is_dicomdir_name(path)) return InputKind::dicomdir;
+    return InputKind::file;
+}
+
+/// The headers of every DICOM file of an input.
+std::vector<Header> read_headers(const std::vector<Source>& sources)
+{
+    std::vector<Header> headers;
+    headers.reserve(sources.size());
+    for (std::size_t i = 0; i < sources.size(); ++i) headers.push_back(read_header(sources[i], i));
+    return headers;
+}
+
+std::vector<Source> input_sources(const fs::path& path)
+{
+    std::vector<fs::path> files;
+    switch (input_kind(path)) {
+    case InputKind::folder:
+        files = folder_dicom_files(path);
+        if (files.empty()) {
+            throw Error(Status::unsupported_format,
+                        path.string() + ": no DICOM file in the folder (expected files with the \"DICM\" mark, or named *.dcm)");
+        }
+        break;
+    case InputKind::dicomdir:
+        files = dicomdir_files(path);
+        if (files.empty()) throw Error(Status::bad_format, path.string() + ": the DICOMDIR names no file");
+        for (const fs::path& f : files) {
+            std::error_code ec;
+            if (!fs::is_regular_file(f, ec)) {
+                throw Error(Status::io_error, str_cat(path.string(), ": names ", f.string(), ", which is not there"));
+            }
+        }
+        break;
+    case InputKind::file: files = {path}; break;
+    }
+    std::vector<Source> sources;
+    sources.reserve(files.size());
+    for (const fs::path& f : files) sources.push_back(Source{f, {}, false, f.string()});
+    return sources;
+}
+
+/// A single file that names a DICOMDIR in its meta header is read as one.
+std::vector<Header> headers_of(const fs::path& path, std::vector<Source>& sources)
+{
+    sources = input_sources(path);
+    std::vector<Header> headers = read_headers(sources);
+    if (headers.size() == 1 && headers.front().modality == "DICOMDIR") {
+        sources.clear();
+        for (const fs::path& f : dicomdir_files(path)) sources.push_back(Source{f, {}, false, f.string()});
+        if (sources.empty()) throw Error(Status::bad_format, path.string() + ": the DICOMDIR names no file");
+        headers = read_headers(sources);
+    }
+    return headers;
+}
+
+} // namespace
+
+Volume read_dicom(const fs::path& path, const ReadOptions& options)
+{
+    std::vector<Source> sources;
+    const std::vector<Header> headers = headers_of(path, sources);
+    const SeriesMap map = group_series(headers);
+    return build_volume(choose_series(map, path.string(), options), sources, path.string());
+}
+
+Volume read_dicom_memory(std::string_view bytes, const std::string& label, const ReadOptions& options)
+{
+    std::vector<Source> sources{Source{{}, bytes, true, label}};
+    std::vector<Header> headers;
+    headers.push_back(read_header(sources.front(), 0));
+    if (headers.front().modality == "DICOMDIR") {
+        throw Error(Status::unsupported_format, label + ": a DICOMDIR; in memory, expected one DICOM image file");
+    }
+    const SeriesMap map = group_series(headers);
+    return build_volume(choose_series(map, label, options), sources, label);
+}
+
+std::vector<DicomSeries> list_dicom_series(const fs::path& path)
+{
+    std::vector<Source> sources;
+    const std::vector<Header> headers = headers_of(path, sources);
+    std::vector<DicomSeries> out;
+    for (const auto& [uid, files] : group_series(headers)) {
+        DicomSeries s;
+        s.uid = uid;
+        s.description = files.front()->description;
+        s.modality = files.front()->modality;
+        s.files = files.size();
+        std::int64_t slices = 0;
+        for (const Header* f : files) slices += f->frames;
+        s.dims = {files.front()->columns, files.front()->rows, slices};
+        try {
+            Grid grid;
+            check_uniform(files, path.string());
+            sort_slices(files, path.string(), grid);
+            s.spacing = grid.spacing;
+        } catch (const Error& e) {
+            s.problem = e.what();
+        }
+        out.push_back(std::move(s));
+    }
+    return out;
+}
+
+std::vector<fs::path> dicom_input_files(const fs::path& path)
+{
+    try {
+        std::vector<fs::path> files;
+        std::error_code ec;
+        if (fs::is_directory(path, ec)) {
+            for (const Source& s : input_sources(path)) files.push_back(s.path);
+            return files;
+        }
+        files.push_back(path);
+        bool dicomdir = is_dicomdir_name(path);
+        if (!dicomdir && has_dicom_mark(file_head(path))) {
+            // a DICOMDIR under another name lists its files too
+            dicomdir = read_header(Source{path, {}, false, path.string()}, 0).modality == "DICOMDIR";
+        }
+        if (dicomdir) {
+            for (const fs::path& f : dicomdir_files(path)) files.push_back(f);
+        }
+        return files;
+    } catch (const std::exception&) {
+        return {path};
+    }
+}
+
+#endif // CMC33_WITH_GDCM
+
+} // namespace cmc33::io::detail
+
+namespace cmc33::io {
+
+bool is_dicom_input(const std::filesystem::path& path)
+{
+    try {
+        return detail::image_input(path) == detail::ImageInput::dicom;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+bool is_tiff_input(const std::filesystem::path& path)
+{
+    try {
+        return detail::image_input(path) == detail::ImageInput::tiff;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+std::vector<DicomSeries> dicom_series(const std::filesystem::path& path)
+{
+    return detail::list_dicom_series(path);
+}
+
+} // namespace cmc33::io

@@ -1,0 +1,253 @@
+// The DICOM reader against pydicom, an independent writer (tests/io/write_dicom.py): shuffled slice
+// files with misleading InstanceNumbers, oblique and sheared frames, non-square pixels, rescale,
+// BitsStored 12, the native and RLE transfer syntaxes, an Enhanced CT, and the broken series that
+// must be refused in one line naming the files or positions.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "cmc33/error.hpp"
+#include "cmc33/extract.hpp"
+#include "cmc33/io.hpp"
+#include "dicom.hpp"
+#include "test_support.hpp"
+
+namespace cmc33 {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// The series write_dicom.py writes, once for the whole suite.
+const fs::path& series_dir()
+{
+    static const fs::path dir = [] {
+        const fs::path d = fs::temp_directory_path() / ("cmc33_test_dicom_" + std::to_string(::getpid()));
+        fs::remove_all(d);
+        const std::string command = std::string(CMC33_SYSTEM_PYTHON) + " " + CMC33_WRITE_DICOM + " " + d.string();
+        if (std::system(command.c_str()) != 0) return fs::path();
+        return d;
+    }();
+    return dir;
+}
+
+class Dicom : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        if (!io::detail::dicom_supported()) GTEST_SKIP() << "this build has no DICOM reader (GDCM not found)";
+        ASSERT_FALSE(series_dir().empty()) << "write_dicom.py failed: needs python3-pydicom and python3-numpy";
+    }
+    static fs::path path(const std::string& name) { return series_dir() / name; }
+    static Volume read(const std::string& name, const std::string& series = {})
+    {
+        io::ReadOptions options;
+        options.series = series;
+        return io::read_volume(path(name), std::nullopt, options);
+    }
+    static std::string error_of(const std::string& name, const std::string& series = {})
+    {
+        try {
+            (void)read(name, series);
+        } catch (const Error& e) {
+            return e.what();
+        }
+        return "(no error)";
+    }
+};
+
+/// The samples as doubles, x fastest.
+std::vector<double> as_doubles(const Volume& volume)
+{
+    return dispatch_scalar_type(volume.type(), [&](auto tag) {
+        using T = decltype(tag);
+        const T* p = volume.samples<T>();
+        return std::vector<double>(p, p + volume.sample_count());
+    });
+}
+
+nlohmann::json expected(const std::string& name)
+{
+    std::ifstream in(series_dir() / (name + ".json"));
+    return nlohmann::json::parse(in);
+}
+
+/// The volume's frame and samples are those pydicom reads back, and every mesh vertex lies where
+/// pydicom's frame puts the same index-space point.
+void check_against_pydicom(const Volume& volume, const std::string& name)
+{
+    const nlohmann::json want = expected(name);
+    for (std::size_t a = 0; a < 3; ++a) EXPECT_EQ(volume.dims()[a], want["dims"][a].get<std::int64_t>()) << name;
+    const Mat3 m = frame_matrix(volume.spacing(), volume.direction());
+    for (std::size_t a = 0; a < 3; ++a) {
+        // DS values carry about 6 decimals: positions and cosines agree to that
+        EXPECT_NEAR(volume.origin()[a], want["origin"][a].get<double>(), 1e-6) << name;
+        for (std::size_t r = 0; r < 3; ++r) {
+            EXPECT_NEAR(m[r][a], want["axes"][a][r].get<double>(), 1e-6) << name << " axis " << a << " row " << r;
+        }
+    }
+    const auto& values = want["values"];
+    ASSERT_EQ(values.size(), static_cast<std::size_t>(volume.sample_count()));
+    Volume reference(ScalarType::f64, volume.dims());
+    double* ref = reference.samples<double>();
+    const std::vector<double> got = as_doubles(volume);
+    for (std::size_t i = 0; i < values.size(); ++i) {
+        ref[i] = values[i].get<double>();
+        ASSERT_NEAR(got[i], ref[i], 1e-4 * (1 + std::fabs(ref[i]))) << name << " sample " << i;
+    }
+    // The mesh in the reader's frame against the mesh in index space mapped by pydicom's frame.
+    double lo = ref[0], hi = ref[0];
+    for (std::size_t i = 0; i < values.size(); ++i) lo = std::min(lo, ref[i]), hi = std::max(hi, ref[i]);
+    const double iso = lo + 0.6 * (hi - lo) + 0.25; // between samples, a closed surface inside
+    const Mesh mesh = extract(volume, iso);
+    const Mesh index_mesh = extract(reference, iso);
+    ASSERT_GT(mesh.triangle_count(), 0u) << name;
+    ASSERT_EQ(mesh.vertex_count(), index_mesh.vertex_count()) << name;
+    ASSERT_EQ(mesh.triangle_count(), index_mesh.triangle_count()) << name;
+    for (std::size_t t = 0; t < mesh.triangles.size(); ++t) ASSERT_EQ(mesh.triangles[t], index_mesh.triangles[t]) << name;
+    double extent = 0;
+    for (std::size_t a = 0; a < 3; ++a) extent = std::max(extent, std::fabs(want["origin"][a].get<double>()));
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        for (std::size_t r = 0; r < 3; ++r) {
+            double world = want["origin"][r].get<double>();
+            for (std::size_t a = 0; a < 3; ++a) {
+                world += want["axes"][a][r].get<double>() * static_cast<double>(index_mesh.positions[3 * v + a]);
+            }
+            // float precision: a few float steps of the coordinates' magnitude
+            ASSERT_NEAR(static_cast<double>(mesh.positions[3 * v + r]), world, 4e-6 * (extent + 20)) << name << " vertex " << v;
+        }
+    }
+}
+
+TEST_F(Dicom, ObliqueRescaledShuffledSeriesMatchesPydicom)
+{
+    const Volume v = read("oblique");
+    EXPECT_EQ(v.type(), ScalarType::i16); // stored int16 minus 1024 fits int16
+    EXPECT_EQ(v.space(), "left-posterior-superior");
+    check_against_pydicom(v, "oblique");
+}
+
+TEST_F(Dicom, NonSquarePixelsPutRowSpacingOnY)
+{
+    // PixelSpacing 0.9\0.6: 0.9 between rows (along the column cosine, y), 0.6 between columns (x)
+    const Volume v = read("oblique");
+    EXPECT_NEAR(v.spacing()[0], 0.6, 1e-12);
+    EXPECT_NEAR(v.spacing()[1], 0.9, 1e-12);
+    EXPECT_NEAR(v.spacing()[2], 1.25, 1e-5);
+}
+
+TEST_F(Dicom, WholeSlopeStaysInteger)
+{
+    const Volume v = read("slope2");
+    EXPECT_EQ(v.type(), ScalarType::i16);
+    check_against_pydicom(v, "slope2");
+}
+
+TEST_F(Dicom, SlopePerSliceGivesFloat)
+{
+    const Volume v = read("perslice");
+    EXPECT_EQ(v.type(), ScalarType::f32);
+    check_against_pydicom(v, "perslice");
+}
+
+TEST_F(Dicom, GantryTiltIsAShearedFrame)
+{
+    const Volume v = read("tilt");
+    check_against_pydicom(v, "tilt");
+    // the slice axis is not the normal of the rows and columns
+    EXPECT_GT(std::fabs(v.direction()[1][2]), 0.2);
+}
+
+TEST_F(Dicom, BitsStored12DropsTheBitsAboveAndExtendsTheSign)
+{
+    const Volume v = read("bits12");
+    check_against_pydicom(v, "bits12");
+}
+
+TEST_F(Dicom, TransferSyntaxes)
+{
+    check_against_pydicom(read("bigendian"), "bigendian");
+    check_against_pydicom(read("implicit"), "implicit");
+    check_against_pydicom(read("rle"), "rle");
+}
+
+TEST_F(Dicom, EnhancedMultiFrameFile)
+{
+    check_against_pydicom(read("enhanced.dcm"), "enhanced");
+}
+
+TEST_F(Dicom, TwoSeriesAreListedAndSeriesPicks)
+{
+    const std::string e = error_of("two");
+    EXPECT_NE(e.find("2 DICOM series"), std::string::npos) << e;
+    EXPECT_NE(e.find("--series"), std::string::npos) << e;
+    EXPECT_NE(e.find("1.2.826.0.1.3680043.38.1"), std::string::npos) << e;
+    EXPECT_NE(e.find("1.2.826.0.1.3680043.38.2"), std::string::npos) << e;
+    EXPECT_NE(e.find("\"Soft\""), std::string::npos) << e;
+    EXPECT_EQ(e.find('\n'), std::string::npos) << e;
+    const Volume bone = read("two", "1.2.826.0.1.3680043.38.1");
+    const Volume soft = read("two", "1.2.826.0.1.3680043.38.2");
+    EXPECT_NEAR(bone.spacing()[2], 1, 1e-9);
+    EXPECT_NEAR(soft.spacing()[2], 2, 1e-9);
+    const std::string unknown = error_of("two", "1.2.3");
+    EXPECT_NE(unknown.find("no series \"1.2.3\""), std::string::npos) << unknown;
+    const std::vector<io::DicomSeries> list = io::detail::list_dicom_series(path("two"));
+    ASSERT_EQ(list.size(), 2u);
+    EXPECT_EQ(list[0].description, "Bone");
+    EXPECT_EQ(list[1].dims, (Index3{5, 4, 3}));
+    EXPECT_NEAR(list[1].spacing[2], 2, 1e-9);
+}
+
+TEST_F(Dicom, BrokenSeriesAreRefusedNamingWhere)
+{
+    std::string e = error_of("missing");
+    EXPECT_NE(e.find("missing slice"), std::string::npos) << e;
+    EXPECT_NE(e.find("s2.dcm at 4 mm"), std::string::npos) << e;
+    EXPECT_NE(e.find("s4.dcm at 8 mm"), std::string::npos) << e;
+    e = error_of("duplicate");
+    EXPECT_NE(e.find("duplicate slice position (0, 0, 6)"), std::string::npos) << e;
+    EXPECT_NE(e.find("s3.dcm"), std::string::npos) << e;
+    EXPECT_NE(e.find("s4.dcm"), std::string::npos) << e;
+    e = error_of("uneven");
+    EXPECT_NE(e.find("non-uniform slice spacing: 1.5 mm"), std::string::npos) << e;
+    e = error_of("mixed");
+    EXPECT_NE(e.find("mixed slice sizes"), std::string::npos) << e;
+    EXPECT_NE(e.find("5x4"), std::string::npos) << e;
+    EXPECT_NE(e.find("6x4"), std::string::npos) << e;
+    e = error_of("rgb");
+    EXPECT_NE(e.find("3 samples per pixel (RGB)"), std::string::npos) << e;
+    for (const std::string name : {"missing", "duplicate", "uneven", "mixed", "rgb"}) {
+        EXPECT_EQ(error_of(name).find('\n'), std::string::npos) << name;
+    }
+}
+
+TEST_F(Dicom, FolderFilesAreInputs)
+{
+    const std::vector<fs::path> files = io::volume_files(path("oblique"));
+    ASSERT_EQ(files.size(), 6u); // the six slice files
+    for (const fs::path& f : files) EXPECT_EQ(f.parent_path(), path("oblique"));
+}
+
+TEST_F(Dicom, NotDicomIsRefusedNamingTheFile)
+{
+    const fs::path dir = test::temp_dir() / "notdicom";
+    fs::create_directories(dir);
+    test::write_file(dir / "a.dcm", std::string(200, 'x'));
+    try {
+        (void)io::read_volume(dir, std::nullopt, io::ReadOptions{});
+        FAIL() << "read";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("a.dcm: not a DICOM file"), std::string::npos) << e.what();
+    }
+}
+
+} // namespace
+} // namespace cmc33
