@@ -4,7 +4,7 @@
 # executions, coverage (cov, ft: libFuzzer's final figures) and crashes; exits 1 if any target
 # crashed, leaked, hung or ran out of memory. Crash inputs are kept in build-fuzz/fuzz-work/.
 #
-# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   targets: nrrd nhdr mha mhd vtk raw ply obj stl off
+# Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   targets: nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff
 # Environment: FUZZ_RUNS=N stops each target after N executions instead (SECONDS then caps the
 # time); FUZZ_NO_BUILD=1 skips the build (for running several instances side by side).
 set -euo pipefail
@@ -15,7 +15,7 @@ if [[ $# -gt 0 && "$1" =~ ^[0-9]+$ ]]; then
     seconds=$1
     shift
 fi
-all=(nrrd nhdr mha mhd vtk raw ply obj stl off)
+all=(nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff)
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=("${all[@]}")
 for t in "${targets[@]}"; do

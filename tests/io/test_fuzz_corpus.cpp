@@ -23,6 +23,8 @@ CMC33_FUZZ_HARNESS(ply)
 CMC33_FUZZ_HARNESS(obj)
 CMC33_FUZZ_HARNESS(stl)
 CMC33_FUZZ_HARNESS(off)
+CMC33_FUZZ_HARNESS(dicom)
+CMC33_FUZZ_HARNESS(tiff)
 #undef CMC33_FUZZ_HARNESS
 
 namespace {
@@ -53,5 +55,7 @@ TEST(FuzzCorpus, Ply) { replay("ply", cmc33_fuzz_ply); }
 TEST(FuzzCorpus, Obj) { replay("obj", cmc33_fuzz_obj); }
 TEST(FuzzCorpus, Stl) { replay("stl", cmc33_fuzz_stl); }
 TEST(FuzzCorpus, Off) { replay("off", cmc33_fuzz_off); }
+TEST(FuzzCorpus, Dicom) { replay("dicom", cmc33_fuzz_dicom); }
+TEST(FuzzCorpus, Tiff) { replay("tiff", cmc33_fuzz_tiff); }
 
 } // namespace
