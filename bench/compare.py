@@ -146,9 +146,11 @@ def main(argv):
         if not args.run_bench_options and base:
             options = options + ["--cases", ",".join(cases_of(base))]
         cmd = [sys.executable, os.path.join(REPO, "bench", "run_bench.py"), "--out", args.out] + options
+        results = os.path.join(args.out, "results.jsonl")
+        if os.path.exists(results):
+            os.remove(results)  # a run that fails must not leave an earlier run's results to compare
         print(f"{PROG}: {' '.join(cmd)}", file=sys.stderr)
         status = subprocess.run(cmd).returncode
-        results = os.path.join(args.out, "results.jsonl")
         if not os.path.exists(results):
             sys.exit(f"{PROG}: run_bench.py exited with status {status} and wrote no {results}")
     new = load(results)
