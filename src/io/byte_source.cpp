@@ -424,6 +424,9 @@ private:
 std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t skip,
                                            std::size_t out_size, const std::string& label)
 {
+#if defined(CMC33_WITH_LIBDEFLATE) && CMC33_WITH_LIBDEFLATE
+    if (std::unique_ptr<std::byte[]> whole = inflate_whole(in, skip, out_size)) return whole;
+#endif
     const MemoryInput input(in, label);
     InflateStream inflater(input, 0, in.size(), label);
     const std::uint64_t wanted = skip + out_size;

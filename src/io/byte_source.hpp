@@ -183,4 +183,13 @@ private:
 std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t skip,
                                            std::size_t out_size, const std::string& label);
 
+#if defined(CMC33_WITH_LIBDEFLATE) && CMC33_WITH_LIBDEFLATE
+/// inflate_exact()'s fast path (inflate_libdeflate.cpp): the stream in `in` inflated by libdeflate
+/// in one call per member into one block of the declared size. Null for anything inflate_exact()
+/// would refuse, and also for a gzip header with a header CRC, a `skip` larger than `out_size` or
+/// memory that cannot be had: then inflate_exact() inflates through InflateStream, whose errors
+/// say what is wrong.
+std::unique_ptr<std::byte[]> inflate_whole(std::string_view in, std::uint64_t skip, std::size_t out_size);
+#endif
+
 } // namespace cmc33::io::detail
