@@ -7,12 +7,18 @@
 // bytes that remain before anything is allocated from it, and every read is bounds-checked.
 // Writers stream a mesh that write_mesh() has already validated (sizes, indices < vertex count).
 
+#include <algorithm>
+#include <bit>
 #include <charconv>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <ostream>
 #include <sstream>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "cmc33/error.hpp"
@@ -107,44 +113,90 @@ private:
 
 // ---- output ---------------------------------------------------------------------------------
 
-/// Accumulates output and hands it to the stream in large blocks.
+/// Stores `value` at `out` in little-endian byte order.
+template <class U> inline void store_le(char* out, U value) noexcept
+{
+    static_assert(std::is_unsigned_v<U>);
+    if constexpr (std::endian::native == std::endian::little) {
+        std::memcpy(out, &value, sizeof(U));
+    } else {
+        for (std::size_t i = 0; i < sizeof(U); ++i) out[i] = static_cast<char>((value >> (8 * i)) & 0xffu);
+    }
+}
+inline void store_f32_le(char* out, float value) noexcept { store_le(out, std::bit_cast<std::uint32_t>(value)); }
+
+/// `count` floats at `out` in little-endian order (a plain copy on a little-endian machine).
+inline void store_f32s_le(char* out, const float* values, std::size_t count) noexcept
+{
+    if constexpr (std::endian::native == std::endian::little) {
+        std::memcpy(out, values, count * sizeof(float));
+    } else {
+        for (std::size_t i = 0; i < count; ++i) store_f32_le(out + 4 * i, values[i]);
+    }
+}
+
+/// `count` 32-bit unsigned integers at `out` in little-endian order.
+inline void store_u32s_le(char* out, const std::uint32_t* values, std::size_t count) noexcept
+{
+    if constexpr (std::endian::native == std::endian::little) {
+        std::memcpy(out, values, count * sizeof(std::uint32_t));
+    } else {
+        for (std::size_t i = 0; i < count; ++i) store_le(out + 4 * i, values[i]);
+    }
+}
+
+/// Accumulates output in one block and hands it to the stream when full: the writers' values go
+/// into memory by plain stores (no stream call, no growth check per byte).
 class OutputBuffer {
 public:
-    explicit OutputBuffer(std::ostream& out) : out_(out) { buffer_.reserve(kBlock + 256); }
+    explicit OutputBuffer(std::ostream& out) : out_(out), data_(new char[kBlock]) {}
     ~OutputBuffer() = default;
     OutputBuffer(const OutputBuffer&) = delete;
     OutputBuffer& operator=(const OutputBuffer&) = delete;
 
-    void text(std::string_view s)
-    {
-        buffer_.append(s);
-        maybe_flush();
-    }
+    void text(std::string_view s) { bytes(s.data(), s.size()); }
     void character(char c)
     {
-        buffer_.push_back(c);
-        maybe_flush();
+        if (used_ == kBlock) flush();
+        data_[used_++] = c;
     }
+    /// `count` bytes as they are.
+    void bytes(const void* data, std::size_t count);
     /// Shortest decimal that reads back as exactly `value` (std::to_chars).
     void real(float value);
     void real(double value); ///< shortest text that reads back as the same double
     void integer(std::uint64_t value);
     void u8(std::uint8_t value) { character(static_cast<char>(value)); }
-    void u16_le(std::uint16_t value);
-    void u32_le(std::uint32_t value);
-    void f32_le(float value);
-    void f64_le(double value);
+    void u16_le(std::uint16_t value) { put_le(value); }
+    void u32_le(std::uint32_t value) { put_le(value); }
+    void f32_le(float value) { put_le(std::bit_cast<std::uint32_t>(value)); }
+    void f64_le(double value) { put_le(std::bit_cast<std::uint64_t>(value)); }
+    /// `count` records of `size` bytes (size <= 4096): fill(out, first, n) writes records first ..
+    /// first + n - 1 to out, as many at a time as the block has room for.
+    template <class Fill> void records(std::size_t count, std::size_t size, Fill&& fill)
+    {
+        for (std::size_t first = 0; first < count;) {
+            if (kBlock - used_ < size) flush();
+            const std::size_t n = std::min(count - first, (kBlock - used_) / size);
+            fill(data_.get() + used_, first, n);
+            used_ += n * size;
+            first += n;
+        }
+    }
     /// Writes what is left; call once at the end.
     void flush();
 
 private:
-    static constexpr std::size_t kBlock = 1 << 20;
-    void maybe_flush()
+    static constexpr std::size_t kBlock = std::size_t{1} << 18;
+    template <class U> void put_le(U value)
     {
-        if (buffer_.size() >= kBlock) flush();
+        if (kBlock - used_ < sizeof(U)) flush();
+        store_le(data_.get() + used_, value);
+        used_ += sizeof(U);
     }
     std::ostream& out_;
-    std::string buffer_;
+    std::unique_ptr<char[]> data_;
+    std::size_t used_ = 0;
 };
 
 } // namespace cmc33::io::detail

@@ -182,61 +182,52 @@ void check_text_end(std::string_view bytes, char comment, const std::string& nam
 
 // ---- output ---------------------------------------------------------------------------------
 
+void OutputBuffer::bytes(const void* data, std::size_t count)
+{
+    const auto* p = static_cast<const char*>(data);
+    if (count >= kBlock) { // a large block goes to the stream as it is
+        flush();
+        out_.write(p, static_cast<std::streamsize>(count));
+        return;
+    }
+    const std::size_t first = std::min(count, kBlock - used_);
+    std::memcpy(data_.get() + used_, p, first);
+    used_ += first;
+    if (first < count) {
+        flush();
+        std::memcpy(data_.get(), p + first, count - first);
+        used_ = count - first;
+    }
+}
+
 void OutputBuffer::real(float value)
 {
-    char digits[32];
-    const auto result = std::to_chars(digits, digits + sizeof digits, value);
-    buffer_.append(digits, result.ptr);
-    maybe_flush();
+    constexpr std::size_t kMax = 32; // the shortest float text is at most 15 characters
+    if (kBlock - used_ < kMax) flush();
+    used_ = static_cast<std::size_t>(std::to_chars(data_.get() + used_, data_.get() + used_ + kMax, value).ptr -
+                                     data_.get());
 }
 
 void OutputBuffer::real(double value)
 {
-    char digits[40];
-    const auto result = std::to_chars(digits, digits + sizeof digits, value);
-    buffer_.append(digits, result.ptr);
-    maybe_flush();
+    constexpr std::size_t kMax = 40; // the shortest double text is at most 24 characters
+    if (kBlock - used_ < kMax) flush();
+    used_ = static_cast<std::size_t>(std::to_chars(data_.get() + used_, data_.get() + used_ + kMax, value).ptr -
+                                     data_.get());
 }
 
 void OutputBuffer::integer(std::uint64_t value)
 {
-    char digits[24];
-    const auto result = std::to_chars(digits, digits + sizeof digits, value);
-    buffer_.append(digits, result.ptr);
-    maybe_flush();
-}
-
-void OutputBuffer::u16_le(std::uint16_t value)
-{
-    buffer_.push_back(static_cast<char>(value & 0xff));
-    buffer_.push_back(static_cast<char>(value >> 8));
-    maybe_flush();
-}
-
-void OutputBuffer::u32_le(std::uint32_t value)
-{
-    for (int shift = 0; shift < 32; shift += 8) {
-        buffer_.push_back(static_cast<char>((value >> shift) & 0xff));
-    }
-    maybe_flush();
-}
-
-void OutputBuffer::f32_le(float value)
-{
-    u32_le(std::bit_cast<std::uint32_t>(value));
-}
-
-void OutputBuffer::f64_le(double value)
-{
-    const auto bits = std::bit_cast<std::uint64_t>(value);
-    u32_le(static_cast<std::uint32_t>(bits));
-    u32_le(static_cast<std::uint32_t>(bits >> 32));
+    constexpr std::size_t kMax = 24; // 2^64 has 20 digits
+    if (kBlock - used_ < kMax) flush();
+    used_ = static_cast<std::size_t>(std::to_chars(data_.get() + used_, data_.get() + used_ + kMax, value).ptr -
+                                     data_.get());
 }
 
 void OutputBuffer::flush()
 {
-    out_.write(buffer_.data(), static_cast<std::streamsize>(buffer_.size()));
-    buffer_.clear();
+    out_.write(data_.get(), static_cast<std::streamsize>(used_));
+    used_ = 0;
 }
 
 void write_position(OutputBuffer& o, const float* p, const double* offset)

@@ -606,6 +606,30 @@ void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* of
 
     const float* p = mesh.positions.data();
     const float* n = mesh.normals.data();
+    const std::uint32_t* t = mesh.triangles.data();
+    if (!ascii && !offset) {
+        // Binary records as they lie in memory: x y z [nx ny nz] floats, then uchar 3 and 3 uints.
+        if (!normals) {
+            o.records(mesh.vertex_count(), kPlyVertexBytes, [&](char* dst, std::size_t first, std::size_t count) {
+                store_f32s_le(dst, p + 3 * first, 3 * count);
+            });
+        } else {
+            o.records(mesh.vertex_count(), kPlyNormalVertexBytes, [&](char* dst, std::size_t first, std::size_t count) {
+                for (std::size_t v = first; v < first + count; ++v, dst += kPlyNormalVertexBytes) {
+                    store_f32s_le(dst, p + 3 * v, 3);
+                    store_f32s_le(dst + 12, n + 3 * v, 3);
+                }
+            });
+        }
+        o.records(mesh.triangle_count(), kPlyFaceBytes, [&](char* dst, std::size_t first, std::size_t count) {
+            for (std::size_t f = first; f < first + count; ++f, dst += kPlyFaceBytes) {
+                dst[0] = 3;
+                store_u32s_le(dst + 1, t + 3 * f, 3);
+            }
+        });
+        o.flush();
+        return;
+    }
     for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
         const std::size_t count = normals ? 6 : 3;
         for (std::size_t k = 0; k < count; ++k) {
@@ -629,7 +653,6 @@ void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* of
         }
         if (ascii) o.character('\n');
     }
-    const std::uint32_t* t = mesh.triangles.data();
     for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
         if (ascii) {
             o.text("3 ");

@@ -263,26 +263,30 @@ void write_stl(const Mesh& mesh, std::ostream& out)
     o.u32_le(static_cast<std::uint32_t>(mesh.triangle_count()));
     const float* p = mesh.positions.data();
     const std::uint32_t* t = mesh.triangles.data();
-    for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
-        const float* a = p + 3 * static_cast<std::size_t>(t[3 * f]);
-        const float* b = p + 3 * static_cast<std::size_t>(t[3 * f + 1]);
-        const float* c = p + 3 * static_cast<std::size_t>(t[3 * f + 2]);
-        // Facet normal: (b - a) x (c - a), unit length; zero for a degenerate triangle.
-        double u[3], v[3];
-        for (int k = 0; k < 3; ++k) {
-            u[k] = static_cast<double>(b[k]) - static_cast<double>(a[k]);
-            v[k] = static_cast<double>(c[k]) - static_cast<double>(a[k]);
+    constexpr std::size_t kRecord = 50; // normal, three corners (12 floats), attribute count (uint16)
+    o.records(mesh.triangle_count(), kRecord, [&](char* dst, std::size_t first, std::size_t count) {
+        for (std::size_t f = first; f < first + count; ++f, dst += kRecord) {
+            const float* a = p + 3 * static_cast<std::size_t>(t[3 * f]);
+            const float* b = p + 3 * static_cast<std::size_t>(t[3 * f + 1]);
+            const float* c = p + 3 * static_cast<std::size_t>(t[3 * f + 2]);
+            // Facet normal: (b - a) x (c - a), unit length; zero for a degenerate triangle.
+            double u[3], v[3];
+            for (int k = 0; k < 3; ++k) {
+                u[k] = static_cast<double>(b[k]) - static_cast<double>(a[k]);
+                v[k] = static_cast<double>(c[k]) - static_cast<double>(a[k]);
+            }
+            double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]};
+            const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            for (int k = 0; k < 3; ++k) {
+                const double x = length > 0 && std::isfinite(length) ? n[k] / length : 0.0;
+                store_f32_le(dst + 4 * k, static_cast<float>(x));
+            }
+            store_f32s_le(dst + 12, a, 3);
+            store_f32s_le(dst + 24, b, 3);
+            store_f32s_le(dst + 36, c, 3);
+            store_le(dst + 48, std::uint16_t{0});
         }
-        double n[3] = {u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                       u[0] * v[1] - u[1] * v[0]};
-        const double length = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        for (double& x : n) x = length > 0 && std::isfinite(length) ? x / length : 0.0;
-        for (double x : n) o.f32_le(static_cast<float>(x));
-        for (const float* corner : {a, b, c}) {
-            for (int k = 0; k < 3; ++k) o.f32_le(corner[k]);
-        }
-        o.u16_le(0);
-    }
+    });
     o.flush();
 }
 
