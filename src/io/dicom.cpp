@@ -763,6 +763,8 @@ std::vector<Slice> sort_slices(const std::vector<const Header*>& files, const st
     grid.spacing[1] = ps[0];
     grid.origin = p0;
     grid.space = "left-posterior-superior";
+    grid.frame_source = slices.front().header->frames > 1 ? "PlanePositionSequence/PlaneOrientationSequence (functional groups)"
+                                                          : "ImagePositionPatient/ImageOrientationPatient";
     grid.dims = {static_cast<std::int64_t>(slices.front().header->columns), static_cast<std::int64_t>(slices.front().header->rows),
                  static_cast<std::int64_t>(n)};
     return slices;
@@ -897,6 +899,7 @@ Volume rescale(std::unique_ptr<std::byte[]> samples, const Grid& grid, const std
         Volume v(type, grid.dims, grid.spacing, grid.origin, std::move(bytes));
         v.set_direction(grid.direction);
         v.set_space(grid.space);
+        v.set_frame_source(grid.frame_source);
         return v;
     };
     bool identity = true, whole = true;

@@ -502,6 +502,7 @@ Volume read_tiff_input(const ByteInput& input, const ReadOptions& options)
     grid.type = type;
     grid.dims = {first.width, first.height, static_cast<std::int64_t>(layout.pages.size())};
     grid.spacing = options.spacing.value_or(layout.spacing);
+    grid.origin = options.origin.value_or(Vec3{0, 0, 0});
     if (layout.pages.size() < 2) {
         throw Error(Status::bad_format, str_cat(label, ": 1 page of ", first.width, "x", first.height,
                                                 " pixels; a volume needs at least 2 (a multi-page file, or a folder of numbered slices)"));
@@ -605,7 +606,7 @@ Volume read_tiff_folder(const fs::path& folder, const ReadOptions& options)
             const Index3 dims{p.width, p.height, static_cast<std::int64_t>(numbered.size())};
             const std::uint64_t bytes = payload_bytes(dims, t, input.label());
             plane = static_cast<std::size_t>(bytes / dims[2]);
-            volume = Volume(t, dims, options.spacing.value_or(spacing), {0, 0, 0});
+            volume = Volume(t, dims, options.spacing.value_or(spacing), options.origin.value_or(Vec3{0, 0, 0}));
         } else if (p.width != first.width || p.height != first.height || t != type) {
             throw Error(Status::bad_format,
                         str_cat(input.label(), " holds ", p.width, "x", p.height, " ", type_name(t), " samples, ",
