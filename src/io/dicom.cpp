@@ -492,6 +492,17 @@ Header read_header(const Source& source, std::size_t index)
         }
         h.frames = static_cast<std::int64_t>(f);
     }
+    // Nothing is allocated per frame before the bytes could hold the frames: native frames take
+    // their samples' bytes, encapsulated ones at least an 8-byte item header each.
+    {
+        const std::uint64_t size = source.in_memory ? source.bytes.size() : InputFile(source.path, source.label).size();
+        const std::uint64_t frame_bytes = is_native(h.ts) ? std::max<std::uint64_t>(1, std::uint64_t{h.rows} * h.columns * (h.bits_allocated / 8)) : 8;
+        if (static_cast<std::uint64_t>(h.frames) > size / frame_bytes + 1) {
+            throw Error(Status::truncated_file,
+                        str_cat(source.label, ": NumberOfFrames ", h.frames, " of ", h.columns, "x", h.rows, " pixels cannot fit in the file's ",
+                                size, " bytes (file cut short, or a wrong NumberOfFrames?)"));
+        }
+    }
     Geometry top;
     read_geometry(ds, top);
     if (!top.pixel_spacing) {
