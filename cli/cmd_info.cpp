@@ -87,6 +87,7 @@ struct Summary {
     Vec3 spacing{}, origin{};
     Mat3 direction = kIdentity3;
     std::string space;
+    std::string frame_source; ///< Volume::frame_source()
     std::int64_t samples = 0;
     std::uint64_t bytes = 0;
     double lo = 0, hi = 0; ///< value_range()
@@ -101,6 +102,7 @@ Summary summarize(const std::string& path, const Volume& volume)
     s.dims = volume.dims();
     s.type = volume.type();
     s.spacing = volume.spacing(), s.origin = volume.origin(), s.direction = volume.direction(), s.space = volume.space();
+    s.frame_source = volume.frame_source();
     s.samples = volume.sample_count();
     s.bytes = volume.byte_size();
     std::tie(s.lo, s.hi) = value_range(volume);
@@ -113,16 +115,20 @@ Summary summarize(const std::string& path, const Volume& volume)
 /// summarize() of a volume read a few planes at a time within `limit` bytes: samples of 8 and
 /// 16 bits in one pass (a count per value, from which the range and the histogram follow), wider
 /// ones in two (the range, then the histogram, whose bins depend on it).
-Summary summarize_slabs(const std::string& path, const std::optional<io::RawOptions>& raw, std::uint64_t limit)
+Summary summarize_slabs(const std::string& path, const std::optional<io::RawOptions>& raw, std::uint64_t limit,
+                        const RawVolumeOptions& options)
 {
-    const io::detail::VolumeLayout layout =
-        named_step(path, "reading the volume's header", [&] { return io::detail::describe_volume(path, raw); });
+    io::detail::VolumeLayout layout = named_step(path, "reading the volume's header", [&] {
+        return io::detail::describe_volume(path, raw, read_options(path, options));
+    });
+    apply_space(layout.grid.origin, layout.grid.direction, layout.grid.space, options, path);
     const io::detail::Grid& g = layout.grid;
     Summary s;
     s.volume = volume_json(path, g.dims, g.type, g.spacing, g.origin, g.direction, g.space);
     s.dims = g.dims;
     s.type = g.type;
     s.spacing = g.spacing, s.origin = g.origin, s.direction = g.direction, s.space = g.space;
+    s.frame_source = g.frame_source;
     s.samples = g.dims[0] * g.dims[1] * g.dims[2];
     s.lo = std::numeric_limits<double>::infinity(), s.hi = -s.lo; // as value_range(): none finite yet
     s.bytes = static_cast<std::uint64_t>(s.samples) * type_size(g.type);
@@ -296,21 +302,55 @@ std::string bar(std::int64_t n, std::int64_t largest)
 
 /// The frame beyond spacing and origin: the named space, and the direction of each axis when
 /// they are not x, y, z themselves (docs/conventions.md).
-void print_frame(const std::string& space, const Mat3& d)
+void print_frame(const std::string& space, const Mat3& d, const std::string& source)
 {
     if (!space.empty()) std::cout << "space " << space << '\n';
+    if (!source.empty()) std::cout << "frame from " << source << '\n';
     if (d == kIdentity3) return;
     std::cout << "directions (world direction of +i, +j, +k):";
     for (std::size_t a = 0; a < 3; ++a) std::cout << " " << "ijk"[a] << " " << vec_text({d[0][a], d[1][a], d[2][a]});
     std::cout << (determinant(d) < 0 ? "; mirrored (det < 0): extract reverses the triangles' winding" : "") << '\n';
 }
 
+/// A DICOM input of several series: what each one is, for --series (one line each, or JSON).
+/// False when the input is not DICOM or holds one series (read as a volume then).
+bool list_dicom_series(const InfoArgs& args)
+{
+    if (!args.raw.series.empty() || !io::is_dicom_input(args.input)) return false;
+    const std::vector<io::DicomSeries> list = named_step(args.input, "reading the DICOM headers", [&] { return io::dicom_series(args.input); });
+    if (list.size() < 2) return false;
+    if (args.json) {
+        Json out = Json::array();
+        for (const io::DicomSeries& s : list) {
+            Json entry = {{"uid", s.uid}, {"description", s.description}, {"modality", s.modality},
+                          {"dims", {s.dims[0], s.dims[1], s.dims[2]}},
+                          {"spacing", {json_number(s.spacing[0]), json_number(s.spacing[1]), json_number(s.spacing[2])}},
+                          {"files", s.files}};
+            if (!s.problem.empty()) entry["problem"] = s.problem;
+            out.push_back(entry);
+        }
+        std::cout << Json{{"file", args.input}, {"series", out}}.dump(2) << '\n';
+        return true;
+    }
+    std::cout << args.input << ": " << list.size() << " DICOM series; read one with --series UID\n";
+    for (const io::DicomSeries& s : list) {
+        std::cout << "  " << s.uid << "  " << (s.modality.empty() ? "" : s.modality + " ")
+                  << (s.description.empty() ? "(no description)" : "\"" + s.description + "\"") << "  " << dims_text(s.dims);
+        if (s.problem.empty()) std::cout << "  spacing " << vec_text(s.spacing);
+        std::cout << "  (" << counted(static_cast<std::int64_t>(s.files), "file") << ")";
+        if (!s.problem.empty()) std::cout << "  not readable: " << s.problem;
+        std::cout << '\n';
+    }
+    return true;
+}
+
 void run_info(const InfoArgs& args)
 {
+    if (list_dicom_series(args)) return;
     const Summary summary = args.memory_limit.empty()
                                 ? summarize(args.input, load_volume(args.input, args.raw))
                                 : summarize_slabs(args.input, raw_volume_options(args.input, args.raw),
-                                                  slabs::parse_size(args.memory_limit));
+                                                  slabs::parse_size(args.memory_limit), args.raw);
     const double lo = summary.lo, hi = summary.hi;
     const NonFinite& bad = summary.bad;
     const Histogram& h = summary.h;
@@ -322,6 +362,7 @@ void run_info(const InfoArgs& args)
 
     if (args.json) {
         Json out = summary.volume;
+        if (!summary.frame_source.empty()) out["frame_source"] = summary.frame_source;
         out["samples"] = summary.samples;
         out["min"] = has_values ? json_number(lo) : Json(nullptr);
         out["max"] = has_values ? json_number(hi) : Json(nullptr);
@@ -346,7 +387,7 @@ void run_info(const InfoArgs& args)
     std::cout << args.input << ": " << dims_text(summary.dims) << " " << type_name(summary.type) << " ("
               << counted(summary.samples, "sample") << ", " << counted(summary.bytes, "byte") << ")\n";
     std::cout << "spacing " << vec_text(summary.spacing) << ", origin " << vec_text(summary.origin) << '\n';
-    print_frame(summary.space, summary.direction);
+    print_frame(summary.space, summary.direction, summary.frame_source);
     if (!has_values) {
         std::cout << "no finite samples\n";
     } else {

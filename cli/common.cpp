@@ -22,6 +22,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "slabs.hpp"
+#include "volume_formats.hpp"
 
 namespace cmc33::cli {
 
@@ -97,17 +98,91 @@ void add_raw_volume_options(CLI::App& command, RawVolumeOptions& raw)
                             ->type_name("N")
                             ->check(unsigned_number())
                             ->group(group));
+    const std::string files = "Volumes in files with a header";
+    command.add_option("--frame", raw.frame, "4-D files (NIfTI, .npy stacks): the frame to read, from 0 (nibabel's [..., N])")
+        ->type_name("N")
+        ->check(whole_number(0, std::numeric_limits<std::int64_t>::max()))
+        ->group(files);
+    command.add_option("--array", raw.array, ".vti: the point-data array to read (default: the active scalars)")
+        ->type_name("NAME")
+        ->check(non_empty("--array"))
+        ->group(files);
+    command.add_option("--origin", raw.origin, ".npy (with --spacing): the position of sample [0, 0, 0] (default 0 0 0)")
+        ->expected(3)
+        ->type_name("X Y Z")
+        ->check(number_check())
+        ->group(files);
+    command.add_option("--space", raw.space,
+                       "World space of the positions: ras or lps (default: the file's own, e.g. NIfTI ras, NRRD and DICOM lps)")
+        ->type_name("SPACE")
+        ->check(CLI::IsMember({"ras", "lps"}))
+        ->group(files);
+    command.add_option("--series", raw.series, "DICOM: the SeriesInstanceUID to read when the input holds several (info lists them)")
+        ->type_name("UID")
+        ->check(non_empty("--series"))
+        ->group(files);
+}
+
+namespace {
+
+/// A .npy file, by its name or its magic: the format whose frame --spacing/--origin give.
+bool is_npy(const std::string& path)
+{
+    if (fs::path(path).extension() == ".npy") return true;
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) return false;
+    char magic[6] = {};
+    const bool npy = std::fread(magic, 1, 6, f) == 6 && std::memcmp(magic, "\x93NUMPY", 6) == 0;
+    std::fclose(f);
+    return npy;
+}
+
+} // namespace
+
+io::ReadOptions read_options(const std::string& path, const RawVolumeOptions& raw)
+{
+    io::ReadOptions options;
+    options.frame = raw.frame;
+    options.array = raw.array;
+    options.series = raw.series;
+    if (is_npy(path) || io::is_tiff_input(path)) { // formats without a frame, or TIFF's to replace
+        if (!raw.spacing.empty()) options.spacing = Vec3{raw.spacing[0], raw.spacing[1], raw.spacing[2]};
+        if (!raw.origin.empty()) options.origin = Vec3{raw.origin[0], raw.origin[1], raw.origin[2]};
+    } else if (!raw.origin.empty()) {
+        throw UsageError("--origin is for .npy files, which have no frame; " + path + " gives its own");
+    }
+    return options;
+}
+
+void apply_space(Vec3& origin, Mat3& direction, std::string& space, const RawVolumeOptions& raw, const std::string& path)
+{
+    if (raw.space.empty()) return;
+    io::detail::convert_space(origin, direction, space, raw.space, path);
 }
 
 Volume load_volume(const std::string& path, const RawVolumeOptions& raw)
 {
     const std::optional<io::RawOptions> options = raw_volume_options(path, raw);
-    return named_step(path, "reading the volume", [&] { return io::read_volume(path, options); });
+    Volume volume = named_step(path, "reading the volume", [&] { return io::read_volume(path, options, read_options(path, raw)); });
+    if (!raw.space.empty()) {
+        Vec3 origin = volume.origin();
+        Mat3 direction = volume.direction();
+        std::string space = volume.space();
+        apply_space(origin, direction, space, raw, path);
+        volume.set_origin(origin);
+        volume.set_direction(direction);
+        volume.set_space(space);
+    }
+    return volume;
 }
 
 std::optional<io::RawOptions> raw_volume_options(const std::string& path, const RawVolumeOptions& raw)
 {
     if (io::has_volume_header(path)) {
+        // --spacing is also the frame of a .npy (read_options)
+        const bool only_spacing = raw.given.size() > 2 && raw.given[2]->count() > 0 &&
+                                  std::count_if(raw.given.begin(), raw.given.end(), [](const CLI::Option* o) { return o->count() > 0; }) == 1;
+        if (only_spacing && (is_npy(path) || io::is_tiff_input(path))) return std::nullopt;
         if (raw.any_given()) {
             throw UsageError("--dims/--type are for headerless raw files; " + path +
                              " has a header that gives its dimensions and type");

@@ -40,6 +40,12 @@ struct RawVolumeOptions {
     std::string endian = "little";
     std::uint64_t header_bytes = 0;
     std::vector<CLI::Option*> given; ///< the options, to tell whether any was on the line
+    // What files with a header leave open (io::ReadOptions), and the world space to write in.
+    std::optional<std::int64_t> frame; ///< --frame N: a 4-D file's frame
+    std::string array;                 ///< --array NAME: a .vti's point-data array
+    std::vector<double> origin;        ///< --origin X Y Z: a .npy's first sample (with --spacing)
+    std::string space;                 ///< --space ras|lps: the world space of positions (empty: the file's)
+    std::string series;                ///< --series UID: the DICOM series to read
 
     bool any_given() const;
 };
@@ -54,6 +60,10 @@ Volume load_volume(const std::string& path, const RawVolumeOptions& raw);
 /// What load_volume() reads `path` with: nullopt for a file with a header, the raw options
 /// otherwise (UsageError and Error as load_volume()).
 std::optional<io::RawOptions> raw_volume_options(const std::string& path, const RawVolumeOptions& raw);
+/// --frame, --array, and --spacing/--origin for a .npy, as the readers take them.
+io::ReadOptions read_options(const std::string& path, const RawVolumeOptions& raw);
+/// --space applied to a frame read from a header (a layout of describe_volume()); nothing without --space.
+void apply_space(Vec3& origin, Mat3& direction, std::string& space, const RawVolumeOptions& raw, const std::string& path);
 
 /// A CLI11 validator accepting the names cmc33::parse_method accepts.
 CLI::Validator method_validator();

@@ -84,8 +84,10 @@ void run_extract_slabs(const ExtractArgs& args)
     // A bad -o must fail before minutes of work, not after.
     check_mesh_output(args.output, false, args.normals, {args.input});
     const std::optional<io::RawOptions> raw = raw_volume_options(args.input, args.raw);
-    const io::detail::VolumeLayout layout =
-        named_step(args.input, "reading the volume's header", [&] { return io::detail::describe_volume(args.input, raw); });
+    io::detail::VolumeLayout layout = named_step(args.input, "reading the volume's header", [&] {
+        return io::detail::describe_volume(args.input, raw, read_options(args.input, args.raw));
+    });
+    apply_space(layout.grid.origin, layout.grid.direction, layout.grid.space, args.raw, args.input);
     const io::detail::Grid& grid = layout.grid;
     // The slabs' records are 32-bit float positions at fixed offsets; a volume far from the origin
     // needs the in-memory run, which writes doubles (--positions).

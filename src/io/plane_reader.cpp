@@ -7,11 +7,30 @@
 
 #include "cmc33/error.hpp"
 #include "atomic_file.hpp"
+#include "dicom.hpp"
 
 namespace cmc33::io::detail {
 
-VolumeLayout describe_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw)
+VolumeLayout describe_volume(const std::filesystem::path& given, const std::optional<RawOptions>& raw,
+                             const ReadOptions& options)
 {
+    // DICOM and TIFF are read whole (slices from files in any order, decoders without plane
+    // offsets); the planes are then copied out of the volume, as for ASCII samples
+    if (image_input(given) == ImageInput::dicom || image_input(given) == ImageInput::tiff) {
+        auto whole = std::make_shared<const Volume>(read_volume(given, raw, options));
+        VolumeLayout layout;
+        layout.grid = Grid{whole->type(), whole->dims(), whole->spacing(), whole->origin(), whole->direction(),
+                           whole->space(), whole->frame_source()};
+        layout.storage.encoding = Encoding::ascii;
+        layout.data_path = given;
+        layout.label = given.string();
+        layout.whole = std::move(whole);
+        return layout;
+    }
+    // a NIfTI pair named by its .img is read through its header, as read_volume() does
+    const std::vector<std::filesystem::path> files = volume_files(given);
+    const bool pair_by_image = lower_extension(given) == ".img" && files.size() == 2;
+    const std::filesystem::path path = pair_by_image ? files[1] : given;
     const std::string label = path.string();
     const std::string ext = lower_extension(path);
     const InputFile file(path, label);
@@ -47,7 +66,16 @@ VolumeLayout describe_volume(const std::filesystem::path& path, const std::optio
         }
         return Volume{};
     };
-    if (ext == ".nrrd" || ext == ".nhdr") {
+    const std::optional<VolumeFormat> sniffed = sniff_volume_format(file);
+    if (sniffed == VolumeFormat::nifti) {
+        read_nifti(file, open_data, options, record, true);
+    } else if (sniffed == VolumeFormat::npy) {
+        read_npy(file, options, record, true);
+    } else if (sniffed == VolumeFormat::vti) {
+        throw Error(Status::unsupported_format,
+                    label + ": a .vti file is read whole (its samples are base64 text or compressed blocks, without plane "
+                            "offsets); read it without --memory-limit");
+    } else if (ext == ".nrrd" || ext == ".nhdr") {
         read_nrrd(file, open_data, ext == ".nhdr", record);
     } else if (ext == ".mhd" || ext == ".mha") {
         read_metaimage(file, open_data, record);

@@ -47,7 +47,8 @@ struct VolumeLayout {
 /// them (the same messages). `raw` as for read_volume().
 /// @throws Error as read_volume()
 CMC33_IO_EXPORT VolumeLayout describe_volume(const std::filesystem::path& path,
-                                             const std::optional<RawOptions>& raw = std::nullopt);
+                                             const std::optional<RawOptions>& raw = std::nullopt,
+                                             const ReadOptions& options = {});
 
 /// Reads planes of the volume `layout` describes. Not thread-safe (one reader per thread).
 class CMC33_IO_EXPORT PlaneReader {

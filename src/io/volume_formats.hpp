@@ -115,6 +115,7 @@ struct Grid {
     Vec3 origin{0, 0, 0};
     Mat3 direction = kIdentity3;
     std::string space; ///< the named space, recorded for `info`
+    std::string frame_source; ///< where the frame came from (Volume::frame_source), for `info`
 };
 
 /// Sets grid.direction and grid.spacing from three axis vectors: axes[a] is the world step of
@@ -193,6 +194,26 @@ Volume read_nrrd(const ByteInput& file, const OpenDataFile& open_data, bool deta
 Volume read_metaimage(const ByteInput& file, const OpenDataFile& open_data, const ReadSamples& read = read_samples);
 Volume read_vtk(const ByteInput& file, const ReadSamples& read = read_samples);
 Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw, const ReadSamples& read = read_samples);
+
+/// NIfTI-1 or NIfTI-2 (nifti.cpp): `file` is a .nii (gzip-compressed or not) or a .hdr whose
+/// samples are in the data file "<stem>.img" (opened through `open_data`). With `planes` the
+/// caller reads the samples plane by plane through `read` (describe_volume()): what must be
+/// converted after reading (scl_slope, 64-bit integers) is refused instead.
+Volume read_nifti(const ByteInput& file, const OpenDataFile& open_data, const ReadOptions& options,
+                  const ReadSamples& read = read_samples, bool planes = false);
+/// NumPy .npy (npy.cpp); `planes` as for read_nifti.
+Volume read_npy(const ByteInput& file, const ReadOptions& options, const ReadSamples& read = read_samples,
+                bool planes = false);
+/// VTK XML ImageData (vti.cpp); read whole (base64 and compressed blocks have no plane offsets).
+Volume read_vti(const ByteInput& file, const ReadOptions& options);
+/// The format of nifti.cpp, npy.cpp or vti.cpp that the first bytes of `file` show (a gzip stream
+/// is inflated far enough to see a NIfTI header), or nullopt.
+std::optional<VolumeFormat> sniff_volume_format(const ByteInput& file);
+
+/// Moves a frame into the anatomical space `target` ("ras", "lps" or a NRRD name): negates the
+/// world axes whose direction differs (world_space.cpp). @throws Error{invalid_argument} naming
+/// `label` for an unknown target, a frame without a space, or a space that is not anatomical.
+void convert_space(Vec3& origin, Mat3& direction, std::string& space, std::string_view target, const std::string& label);
 
 /// The data file a detached header names: "<stem>.raw" in the header's folder.
 std::filesystem::path data_file_beside(const std::filesystem::path& header);

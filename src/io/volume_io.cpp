@@ -18,6 +18,8 @@
 #include "atomic_file.hpp"
 #include "byte_source.hpp"
 #include "volume_formats.hpp"
+#include "dicom.hpp"
+#include "tiff.hpp"
 
 namespace cmc33::io {
 namespace detail {
@@ -435,6 +437,7 @@ Volume allocate(const Grid& grid, const std::string& label)
         Volume volume(grid.type, grid.dims, grid.spacing, grid.origin);
         volume.set_direction(grid.direction);
         volume.set_space(grid.space);
+        volume.set_frame_source(grid.frame_source);
         return volume;
     } catch (const Error& e) {
         throw Error(e.status(), label + ": " + e.what());
@@ -626,6 +629,7 @@ Volume read_samples(const ByteInput& file, const Grid& grid, const Storage& stor
             Volume volume(grid.type, grid.dims, grid.spacing, grid.origin, std::move(samples));
             volume.set_direction(grid.direction);
             volume.set_space(grid.space);
+            volume.set_frame_source(grid.frame_source);
             return volume;
         } catch (const Error& e) {
             throw Error(e.status(), label + ": " + e.what());
@@ -724,16 +728,81 @@ ScalarType parse_type(const std::string& name)
                     "(or char, uchar, short, ushort, int, uint, float32, float64)");
 }
 
+namespace {
+
+/// x.hdr beside x.img when it holds a NIfTI header (a NIfTI pair named by its data file).
+std::optional<std::filesystem::path> nifti_pair_header(const std::filesystem::path& path)
+{
+    if (detail::lower_extension(path) != ".img") return std::nullopt;
+    for (const char* ext : {".hdr", ".HDR"}) {
+        std::filesystem::path header = path;
+        header.replace_extension(ext);
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(header, ec)) continue;
+        try {
+            const detail::InputFile file(header, header.string());
+            if (detail::sniff_volume_format(file) == VolumeFormat::nifti) return header;
+        } catch (const Error&) {
+        }
+    }
+    return std::nullopt;
+}
+
+/// The format the content of `path` shows (NIfTI, .npy, .vti), or nullopt (also when unreadable).
+std::optional<VolumeFormat> sniffed_format(const std::filesystem::path& path)
+{
+    try {
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+        const detail::InputFile file(path, path.string());
+        return detail::sniff_volume_format(file);
+    } catch (const Error&) {
+        return std::nullopt;
+    }
+}
+
+/// NIfTI, .npy and .vti, read by content; `open_data` serves a NIfTI pair's .img.
+Volume read_sniffed(VolumeFormat format, const detail::ByteInput& file, const detail::OpenDataFile& open_data,
+                    const ReadOptions& options)
+{
+    switch (format) {
+    case VolumeFormat::nifti: return detail::read_nifti(file, open_data, options);
+    case VolumeFormat::npy: return detail::read_npy(file, options);
+    case VolumeFormat::vti: return detail::read_vti(file, options);
+    default: break;
+    }
+    throw Error(Status::internal, file.label() + ": not a format read by content");
+}
+
+} // namespace
+
 bool has_volume_header(const std::filesystem::path& path)
 {
     const std::string ext = detail::lower_extension(path);
-    return ext == ".nrrd" || ext == ".nhdr" || ext == ".mhd" || ext == ".mha" || ext == ".vtk";
+    if (ext == ".nrrd" || ext == ".nhdr" || ext == ".mhd" || ext == ".mha" || ext == ".vtk" || ext == ".nii" ||
+        ext == ".hdr" || ext == ".npy" || ext == ".vti" || detail::lower_ascii(path.filename().string()).ends_with(".nii.gz")) {
+        return true;
+    }
+    return nifti_pair_header(path) || sniffed_format(path) || detail::image_input(path) != detail::ImageInput::none;
 }
 
 std::vector<std::filesystem::path> volume_files(const std::filesystem::path& path)
 {
+    // a DICOM or TIFF folder: the files in it that are read
+    if (auto files = detail::image_input_files(path)) return std::move(*files);
     std::vector<std::filesystem::path> files{path};
     const std::string ext = detail::lower_extension(path);
+    // a NIfTI pair: the header and its data file <stem>.img, whichever of them was named
+    if (const auto header = nifti_pair_header(path)) {
+        files.push_back(*header);
+        return files;
+    }
+    if (ext == ".hdr" || sniffed_format(path) == VolumeFormat::nifti) {
+        std::filesystem::path image = path;
+        image.replace_extension(".img");
+        if (image != path) files.push_back(image);
+        return files;
+    }
     const bool nrrd = ext == ".nrrd" || ext == ".nhdr";
     if (!nrrd && ext != ".mhd" && ext != ".mha") return files; // VTK and raw files hold their samples
     std::string head;
@@ -749,8 +818,12 @@ std::vector<std::filesystem::path> volume_files(const std::filesystem::path& pat
     return files;
 }
 
-Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw)
+Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw, const ReadOptions& options)
 {
+    // DICOM and TIFF: folders, and files told by their marks (dicom.cpp)
+    if (auto image = detail::read_image_input(path, options)) return std::move(*image);
+    // a NIfTI pair named by its .img: read through its header
+    if (const auto header = nifti_pair_header(path)) return read_volume(*header, raw, options);
     const std::string label = path.string();
     const std::string ext = detail::lower_extension(path);
     const detail::InputFile file(path, label);
@@ -759,6 +832,11 @@ Volume read_volume(const std::filesystem::path& path, const std::optional<RawOpt
         const std::filesystem::path data = detail::resolve_data_file(path, name);
         return std::make_unique<detail::InputFile>(data, label + ": data file " + data.string());
     };
+    // by content first (magic bytes), then by extension
+    if (const auto format = detail::sniff_volume_format(file)) return read_sniffed(*format, file, open_data, options);
+    if (ext == ".nii" || ext == ".hdr" || detail::lower_ascii(path.filename().string()).ends_with(".nii.gz")) return detail::read_nifti(file, open_data, options);
+    if (ext == ".npy") return detail::read_npy(file, options);
+    if (ext == ".vti") return detail::read_vti(file, options);
     if (ext == ".nrrd" || ext == ".nhdr") return detail::read_nrrd(file, open_data, ext == ".nhdr");
     if (ext == ".mhd" || ext == ".mha") return detail::read_metaimage(file, open_data);
     if (ext == ".vtk") return detail::read_vtk(file);
@@ -767,7 +845,7 @@ Volume read_volume(const std::filesystem::path& path, const std::optional<RawOpt
 
 Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format,
                                const std::string& label, const std::optional<RawOptions>& raw,
-                               const MemoryFiles& data_files)
+                               const MemoryFiles& data_files, const ReadOptions& options)
 {
     const detail::MemoryInput input(bytes, label);
     const detail::OpenDataFile open_data =
@@ -786,6 +864,11 @@ Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format,
     case VolumeFormat::metaimage: return detail::read_metaimage(input, open_data);
     case VolumeFormat::vtk: return detail::read_vtk(input);
     case VolumeFormat::raw: break;
+    case VolumeFormat::dicom: return detail::read_dicom_memory(bytes, label, options);
+    case VolumeFormat::tiff: return detail::read_tiff_memory(bytes, label, options);
+    case VolumeFormat::nifti:
+    case VolumeFormat::npy:
+    case VolumeFormat::vti: return read_sniffed(format, input, open_data, options);
     }
     return detail::read_raw(input, raw);
 }

@@ -132,6 +132,10 @@ public:
     void set_origin(const Vec3& o) noexcept { origin_ = o; }
     void set_direction(const Mat3& d) noexcept { direction_ = d; }
     void set_space(std::string name) { space_ = std::move(name); }
+    /// Where the reader took the frame from, for `info` ("sform (code 2: aligned)", "qform",
+    /// "pixdim", "Direction", ...); empty when the format has a single way to give it.
+    const std::string& frame_source() const noexcept { return frame_source_; }
+    void set_frame_source(std::string source) { frame_source_ = std::move(source); }
     std::int64_t sample_count() const noexcept { return dims_[0] * dims_[1] * dims_[2]; }
     std::size_t byte_size() const noexcept { return static_cast<std::size_t>(sample_count()) * type_size(type_); }
     std::byte* bytes() noexcept { return data_.get(); }
@@ -164,6 +168,7 @@ private:
     Vec3 origin_{0, 0, 0};
     Mat3 direction_ = kIdentity3;
     std::string space_;
+    std::string frame_source_;
     std::unique_ptr<std::byte[]> data_;
 };
 

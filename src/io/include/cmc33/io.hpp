@@ -37,6 +37,22 @@ struct RawOptions {
     std::uint64_t header_bytes = 0; ///< bytes to skip at the start
 };
 
+/// The choices a file leaves to its reader: which of several volumes it holds to read, and the frame
+/// of a format that has none. Each field matters to some formats and is ignored by the others.
+struct ReadOptions {
+    /// 4-D files (NIfTI dim[4] > 1): the frame to read, from 0, as nibabel's img.dataobj[..., N].
+    /// Required when the file holds several frames; a 3-D file has frame 0 only.
+    std::optional<std::int64_t> frame;
+    /// VTK XML ImageData (.vti): the point-data array to read when there are several (default:
+    /// the active Scalars, else the only array).
+    std::string array;
+    /// DICOM: the SeriesInstanceUID to read when a folder holds several series.
+    std::string series;
+    /// Formats that give no frame (.npy): the distance between samples along x, y, z and the
+    /// position of the first sample (defaults 1 and 0). Refused for formats that give their own.
+    std::optional<Vec3> spacing, origin;
+};
+
 /// Parses "int8|uint8|int16|uint16|int32|uint32|float|double" (also "char", "uchar", "short",
 /// "ushort", "int", "uint", "float32", "float64"). @throws Error{invalid_argument}.
 CMC33_IO_EXPORT ScalarType parse_type(const std::string& name);
@@ -44,7 +60,37 @@ CMC33_IO_EXPORT ScalarType parse_type(const std::string& name);
 /// Reads a volume; `raw` is required for headerless files and ignored otherwise.
 /// Samples are converted to the machine's byte order.
 /// @throws Error (io_error, truncated_file, bad_format, unsupported_format, too_large)
-CMC33_IO_EXPORT Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw = std::nullopt);
+CMC33_IO_EXPORT Volume read_volume(const std::filesystem::path& path, const std::optional<RawOptions>& raw = std::nullopt,
+                                   const ReadOptions& options = {});
+
+/// One DICOM series of an input (a folder, a DICOMDIR or a file), as `cmc33 info` lists them.
+struct DicomSeries {
+    std::string uid;         ///< SeriesInstanceUID
+    std::string description; ///< SeriesDescription (may be empty)
+    std::string modality;    ///< Modality (CT, MR, ...; may be empty)
+    Index3 dims{0, 0, 0};    ///< columns, rows, slices (frames)
+    Vec3 spacing{0, 0, 0};   ///< between columns, between rows, between slices (0 when it cannot be read)
+    std::size_t files = 0;   ///< the files that hold it
+    std::string problem;     ///< why the series cannot be read as a volume (empty when it can)
+};
+
+/// The DICOM series `path` holds (a folder of slice files, a DICOMDIR or one file), from the
+/// files' headers only, in the order of their UIDs. @throws Error for a missing input or one
+/// without a DICOM image, or when this build has no DICOM reader.
+CMC33_IO_EXPORT std::vector<DicomSeries> dicom_series(const std::filesystem::path& path);
+
+/// Inputs told by their content, which read_volume() reads without RawOptions: DICOM (a folder
+/// of DICOM files, a DICOMDIR, a file with the "DICM" mark) and TIFF (a file with the TIFF mark,
+/// a folder of .tif/.tiff slices). Never throw.
+CMC33_IO_EXPORT bool is_dicom_input(const std::filesystem::path& path);
+CMC33_IO_EXPORT bool is_tiff_input(const std::filesystem::path& path);
+
+/// Moves the volume's frame into the anatomical world space `space`: "ras" (x to the right, y
+/// anterior, z superior: NIfTI's, nibabel's affine) or "lps" (DICOM's, NRRD's usual), or a NRRD
+/// space name. The world axes whose direction differs from the volume's space() are negated (origin
+/// and direction rows); space() names the new space. @throws Error{invalid_argument} when the
+/// volume names no space (e.g. .npy, NIfTI without sform or qform) or one that is not anatomical.
+CMC33_IO_EXPORT void convert_space(Volume& volume, std::string_view space);
 
 /// Writes a volume: .nrrd (attached, raw), .nhdr (+ .raw beside it), .mhd (+ .raw), .mha,
 /// .vtk (binary, big-endian), .raw (headerless, machine order). @throws Error.
@@ -74,6 +120,11 @@ enum class VolumeFormat {
     metaimage, ///< .mha (ElementDataFile = LOCAL) or .mhd (ElementDataFile = NAME)
     vtk,       ///< VTK legacy STRUCTURED_POINTS
     raw,       ///< headerless samples described by RawOptions
+    nifti,     ///< NIfTI-1 or NIfTI-2: .nii (gzip-compressed or not), or a .hdr whose .img is a data file
+    npy,       ///< NumPy .npy, versions 1.0, 2.0, 3.0
+    vti,       ///< VTK XML ImageData
+    dicom,     ///< one DICOM file: a multi-frame image (Enhanced CT/MR and the like)
+    tiff,      ///< one TIFF file: its pages are the z slices (ImageJ hyperstacks, OME-TIFF)
 };
 
 /// The data files of a detached header, held in memory: called with the name as the header writes
@@ -94,7 +145,7 @@ using MemoryFiles = std::function<std::optional<std::string_view>(std::string_vi
 ///                                            std::nullopt, files);
 CMC33_IO_EXPORT Volume read_volume_from_memory(std::string_view bytes, VolumeFormat format, const std::string& label,
                                const std::optional<RawOptions>& raw = std::nullopt,
-                               const MemoryFiles& data_files = {});
+                               const MemoryFiles& data_files = {}, const ReadOptions& options = {});
 
 /// A mesh format, for bytes that have no file name to tell it.
 enum class MeshFormat { ply, obj, stl, off };
