@@ -14,9 +14,12 @@ import os
 import subprocess
 import sys
 
-import numpy as np
-
 SKIP = 77
+try:
+    import numpy as np
+except ImportError:
+    print("skipped: numpy is not installed (python3-numpy)")
+    sys.exit(SKIP)
 
 
 def ply_vertices(path):

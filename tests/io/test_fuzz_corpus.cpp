@@ -25,6 +25,8 @@ CMC33_FUZZ_HARNESS(stl)
 CMC33_FUZZ_HARNESS(off)
 CMC33_FUZZ_HARNESS(dicom)
 CMC33_FUZZ_HARNESS(tiff)
+CMC33_FUZZ_HARNESS(nifti)
+CMC33_FUZZ_HARNESS(npy)
 #undef CMC33_FUZZ_HARNESS
 
 namespace {
@@ -57,5 +59,7 @@ TEST(FuzzCorpus, Stl) { replay("stl", cmc33_fuzz_stl); }
 TEST(FuzzCorpus, Off) { replay("off", cmc33_fuzz_off); }
 TEST(FuzzCorpus, Dicom) { replay("dicom", cmc33_fuzz_dicom); }
 TEST(FuzzCorpus, Tiff) { replay("tiff", cmc33_fuzz_tiff); }
+TEST(FuzzCorpus, Nifti) { replay("nifti", cmc33_fuzz_nifti); }
+TEST(FuzzCorpus, Npy) { replay("npy", cmc33_fuzz_npy); }
 
 } // namespace
