@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Writes the seed corpora fuzz/corpus/nifti and fuzz/corpus/npy with nibabel and numpy: small
+"""Writes the seed corpora fuzz/corpus/nifti, npy and vti with nibabel, numpy and VTK: small
 volumes of several types, gzip, 4-D, qform only, sform, big-endian, NIfTI-2, a .hdr/.img pair
 (fuzz_nifti.cpp's layout: a frame byte, the file, "\\0IMG\\0", the .img), C and Fortran order, each
 .npy version. Run from the repository's root: /usr/bin/python3 fuzz/make_corpus_nifti_npy.py"""
@@ -60,3 +60,37 @@ for n, (dtype, order, version) in enumerate((("<f4", "C", (1, 0)), (">f8", "F", 
 f = io.BytesIO()
 np.lib.format.write_array(f, np.stack([base, base * 2]).astype("<f4"))
 put("npy", "stack_frame1.npy", b"\1" + f.getvalue())
+
+# .vti (fuzz_vti.cpp: an --array byte, then the file), written by VTK in each data mode
+try:
+    import vtk
+    from vtk.util import numpy_support
+except ImportError:
+    vtk = None
+if vtk is not None:
+    import tempfile
+
+    for n, (mode, zlib, header, b64) in enumerate((("ascii", False, 32, None), ("binary", False, 32, None), ("binary", True, 64, None),
+                                                   ("appended", False, 64, True), ("appended", True, 32, False))):
+        img = vtk.vtkImageData()
+        img.SetDimensions(3, 3, 2)
+        img.SetOrigin(1, -2, 3)
+        img.SetSpacing(0.5, 1, 2)
+        img.SetDirectionMatrix(0, 1, 0, -1, 0, 0, 0, 0, 1)
+        arr = numpy_support.numpy_to_vtk((rng.random(18) * 100).astype((np.float32, np.int16)[n % 2]), deep=True)
+        arr.SetName("density")
+        img.GetPointData().SetScalars(arr)
+        w = vtk.vtkXMLImageDataWriter()
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "a.vti")
+            w.SetFileName(path)
+            w.SetInputData(img)
+            {"ascii": w.SetDataModeToAscii, "binary": w.SetDataModeToBinary, "appended": w.SetDataModeToAppended}[mode]()
+            w.SetCompressorTypeToZLib() if zlib else w.SetCompressorTypeToNone()
+            w.SetBlockSize(32)
+            w.SetHeaderTypeToUInt64() if header == 64 else w.SetHeaderTypeToUInt32()
+            if b64 is not None:
+                w.SetEncodeAppendedData(b64)
+            w.Write()
+            with open(path, "rb") as f:
+                put("vti", f"image_{n}_{mode}{'_zlib' if zlib else ''}.vti", bytes([n % 2]) + f.read())

@@ -18,10 +18,10 @@ set -euo pipefail
 # libgdcm-dev and libtiff-dev are the DICOM and TIFF readers' libraries (without them the build
 # configures and refuses those formats by name); python3-pydicom and python3-tifffile write the
 # volumes the DICOM and TIFF tests read (tests/io/*.py), as independent writers; python3-nibabel
-# writes the NIfTI files of tests/io/independent_writers.py.
+# and python3-vtk9 write the NIfTI and .vti files of tests/io/independent_writers.py.
 packages=(g++ cmake ninja-build pkg-config zlib1g-dev libdeflate-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev
-          libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile python3-nibabel)
+          libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile python3-nibabel python3-vtk9)
 for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;

@@ -252,13 +252,16 @@ def check_vti(c):
     direction = np.array([[np.cos(theta), 0, np.sin(theta)], [0, 1, 0], [-np.sin(theta), 0, np.cos(theta)]]) @ np.diag([1, -1, 1])
     origin, spacing = (3.5, -2.0, 11.0), (0.7, 1.3, 2.1)
 
+    def stored(dtype):
+        return (values if np.dtype(dtype).kind == "f" else np.round(values * 100)).astype(dtype)
+
     def image(dtype):
         img = vtk.vtkImageData()
         img.SetDimensions(nx, ny, nz)
         img.SetOrigin(*origin)
         img.SetSpacing(*spacing)
         img.SetDirectionMatrix(*direction.flatten())
-        arr = numpy_support.numpy_to_vtk(values.astype(dtype).ravel(order="F"), deep=True)
+        arr = numpy_support.numpy_to_vtk(stored(dtype).ravel(order="F"), deep=True)
         arr.SetName("density")
         img.GetPointData().SetScalars(arr)
         return img
@@ -296,8 +299,8 @@ def check_vti(c):
         if base64 is not None:
             w.SetEncodeAppendedData(base64)
         assert w.Write() == 1
-        samples = values.astype(dtype).astype(np.float64)
-        iso = 0.5 if dtype in (np.float32, np.float64) else 0.0
+        samples = stored(dtype).astype(np.float64)
+        iso = 0.5 if dtype in (np.float32, np.float64) else 50.5
         c.compare(f"vti {mode} {compressor or 'raw'} UInt{header} {'base64' if base64 else ''} {np.dtype(dtype).name}", path, samples,
                   iso, to_world(img))
     return True

@@ -27,6 +27,7 @@ CMC33_FUZZ_HARNESS(dicom)
 CMC33_FUZZ_HARNESS(tiff)
 CMC33_FUZZ_HARNESS(nifti)
 CMC33_FUZZ_HARNESS(npy)
+CMC33_FUZZ_HARNESS(vti)
 #undef CMC33_FUZZ_HARNESS
 
 namespace {
@@ -61,5 +62,6 @@ TEST(FuzzCorpus, Dicom) { replay("dicom", cmc33_fuzz_dicom); }
 TEST(FuzzCorpus, Tiff) { replay("tiff", cmc33_fuzz_tiff); }
 TEST(FuzzCorpus, Nifti) { replay("nifti", cmc33_fuzz_nifti); }
 TEST(FuzzCorpus, Npy) { replay("npy", cmc33_fuzz_npy); }
+TEST(FuzzCorpus, Vti) { replay("vti", cmc33_fuzz_vti); }
 
 } // namespace
