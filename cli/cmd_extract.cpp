@@ -91,14 +91,26 @@ void run_extract(const ExtractArgs& args)
     if (mesh.triangle_count() == 0) std::cerr << empty_mesh_note(args.input, args.iso, value_range(volume)) << '\n';
     MeshTopology topology;
     MeshGeometry geometry;
+    bool structured = false;
     if (!args.no_topology) {
-        topology = named_step(args.input, "computing the mesh's topology (about 24 bytes per triangle; "
-                                          "--no-topology skips it)",
-                              [&] { return mesh_topology(mesh); });
-    }
-    if (!args.no_topology) {
-        geometry = named_step(args.input, "checking the mesh's geometry",
-                              [&] { return mesh_geometry(mesh, MeshGeometryOptions{args.threads, 8}); });
+        // with the grid's structure (extract()'s layout of planes), slab by slab in parallel
+        ExtractedGrid grid{volume.dims(), volume.spacing(), volume.origin(), volume.direction(),
+                           stats.plane_first_vertex, stats.plane_first_triangle};
+        MeshCheckOptions check_options;
+        check_options.threads = args.threads;
+        const Progress progress = fraction_line(args.progress, args.quiet, "checking the mesh");
+        check_options.progress = progress;
+        const MeshCheck check = named_step(args.input, "checking the mesh", [&] {
+            try {
+                return check_extracted_mesh(mesh, grid, check_options);
+            } catch (...) {
+                end_progress_line();
+                throw;
+            }
+        });
+        topology = check.topology;
+        geometry = check.geometry;
+        structured = check.structured;
     }
     if (!args.output.empty()) {
         named_step(args.output, "writing the mesh",
@@ -120,6 +132,9 @@ void run_extract(const ExtractArgs& args)
     report.geometry = geometry;
     report.stats = stats;
     report.extra["positions"] = offset ? "double" : "float";
+    // how the check ran: with the grid's structure, or the general checks (a mesh the grid's layout
+    // does not describe: cmc33-paper's refined grid, or one with coincident vertices)
+    report.extra["check"] = args.no_topology ? Json(nullptr) : Json(structured ? "structured" : "general");
     print_extract_report(args, report);
 }
 
@@ -151,7 +166,7 @@ void add_extract(CLI::App& app)
         ->type_name("N")
         ->check(whole_number(1, 1000000));
     cmd->add_flag("--no-topology", args->no_topology,
-                  "Skip the mesh topology (saves time and about 24 bytes per triangle; JSON topology: null)");
+                  "Skip the check of the mesh's topology and embedding (JSON topology and geometry: null)");
     auto* progress = cmd->add_flag("--progress", args->progress,
                                    "Progress lines on stderr even when it is not a terminal");
     cmd->add_flag("--quiet", args->quiet, "No progress line (shown on a terminal when extraction takes over a second)")

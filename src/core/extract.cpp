@@ -1791,6 +1791,16 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
             for (std::size_t i = 0; i < static_cast<std::size_t>(kSubcaseCount); ++i) {
                 stats->cells_per_subcase[i] += c.stats().cells_per_subcase[i];
             }
+        stats->plane_first_vertex.reserve(static_cast<std::size_t>(nz) + 1);
+        stats->plane_first_triangle.reserve(static_cast<std::size_t>(nz) + 1);
+        for (std::size_t r = 0; r < counts.size(); ++r) {
+            for (std::int64_t k = counts[r].k0(); k < counts[r].k1(); ++k) {
+                stats->plane_first_vertex.push_back(offsets[r].first_vertex + counts[r].plane_first_vertex(k));
+                stats->plane_first_triangle.push_back(offsets[r].first_triangle + counts[r].plane_first_triangle(k));
+            }
+        }
+        stats->plane_first_vertex.push_back(nv);
+        stats->plane_first_triangle.push_back(nt);
     }
     return mesh;
 }

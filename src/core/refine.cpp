@@ -413,7 +413,12 @@ template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, con
     ExtractOptions refined_options = options;
     refined_options.normals = false;
     Mesh mesh = extract_passes(r.view(), r.iso, refined_options, stats);
-    if (stats) stats->refinement_planes = planes;
+    if (stats) {
+        stats->refinement_planes = planes;
+        // the layout is the refined grid's, which the caller does not have
+        stats->plane_first_vertex.clear();
+        stats->plane_first_triangle.clear();
+    }
 
     // back to the original grid's index space, then its world frame
     const Mat3 m = frame_matrix(grid.spacing, grid.direction);

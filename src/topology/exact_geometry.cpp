@@ -170,6 +170,12 @@ int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop)
     const double pa[2] = {a[u], a[v]}, pb[2] = {b[u], b[v]}, pc[2] = {c[u], c[v]};
     double dac[2], dbc[2];
     if (exact_differences(pa, pc, dac, 2) && exact_differences(pb, pc, dbc, 2)) {
+        // both products exact (collinear points of a grid-aligned mesh, typically): l - r has
+        // the sign of the exact determinant, rounding or not
+        if (std::fma(acx, bcy, -l) == 0 && std::fma(acy, bcx, -r) == 0) {
+            ++g_stats.expansion;
+            return sign_of(det);
+        }
         double terms[4];
         terms[0] = dac[0] * dbc[1];
         terms[1] = std::fma(dac[0], dbc[1], -terms[0]);
@@ -274,13 +280,54 @@ bool segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, c
     return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
 }
 
+namespace {
+
+/// The coordinate to drop when projecting triangle t: its normal's largest component (rounding may
+/// pick another; every projection gives a valid test below, this one a non-degenerate picture).
+int dominant_axis(const std::array<Point3, 3>& t)
+{
+    const double e[2][3] = {{t[1][0] - t[0][0], t[1][1] - t[0][1], t[1][2] - t[0][2]},
+                            {t[2][0] - t[0][0], t[2][1] - t[0][1], t[2][2] - t[0][2]}};
+    const double n[3] = {std::fabs(e[0][1] * e[1][2] - e[0][2] * e[1][1]), std::fabs(e[0][2] * e[1][0] - e[0][0] * e[1][2]),
+                         std::fabs(e[0][0] * e[1][1] - e[0][1] * e[1][0])};
+    return n[0] >= n[1] && n[0] >= n[2] ? 0 : n[1] >= n[2] ? 1 : 2;
+}
+
+/// Projected along `drop`, x lies strictly on one side of the line pq and y and z strictly on the
+/// other. Then the plane through p and q parallel to the dropped axis separates: a triangle with
+/// corners p, q (or p), x and one with p, q (or p), y, z meet only in what they share.
+bool split_by_line(const Point3& p, const Point3& q, const Point3& x, const Point3& y, const Point3& z, int drop)
+{
+    const int s = orient2d(p, q, x, drop);
+    return s != 0 && orient2d(p, q, y, drop) == -s && orient2d(p, q, z, drop) == -s;
+}
+
+} // namespace
+
 bool triangles_meet_improperly(const std::array<Point3, 3>& t, const std::array<Point3, 3>& u, int shared)
 {
+    // The usual cases first, decided by filtered 2D orientations, which settle coplanar neighbours
+    // (flat parts of a surface) without exact arithmetic: a line through the shared corners that
+    // has the rest of t strictly on one side and the rest of u strictly on the other.
+    if (shared == 2 && split_by_line(t[0], t[1], t[2], u[2], u[2], dominant_axis(t))) return false;
+    if (shared == 1) {
+        const int drop = dominant_axis(t);
+        if (split_by_line(t[0], t[1], t[2], u[1], u[2], drop) || split_by_line(t[0], t[2], t[1], u[1], u[2], drop) ||
+            split_by_line(u[0], u[1], u[2], t[1], t[2], drop) || split_by_line(u[0], u[2], u[1], t[1], t[2], drop))
+            return false;
+    }
     if (shared == 0) return triangles_meet(t, u);
     if (shared == 1) {
         // t = (v, a, b), u = (v, c, d): the convex set t ∩ u holds v; it holds more iff an
         // opposite edge meets the other triangle or an edge at v runs into the other triangle.
         const Point3 &v = t[0], &a = t[1], &b = t[2], &c = u[1], &d = u[2];
+        // the usual case first: one triangle's other corners strictly on one side of the other's
+        // plane, which then holds only v of it
+        for (int pass = 0; pass < 2; ++pass) {
+            const int s0 = pass == 0 ? orient3d(v, a, b, c) : orient3d(v, c, d, a);
+            if (s0 == 0) continue;
+            if ((pass == 0 ? orient3d(v, a, b, d) : orient3d(v, c, d, b)) == s0) return false;
+        }
         return segment_meets_triangle(a, b, v, c, d) || segment_meets_triangle(c, d, v, a, b) ||
                edge_enters_at_shared_corner(v, a, c, d) || edge_enters_at_shared_corner(v, b, c, d) ||
                edge_enters_at_shared_corner(v, c, a, b) || edge_enters_at_shared_corner(v, d, a, b);

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 #include <functional>
 #include <string_view>
 
@@ -67,6 +68,11 @@ struct ExtractOptions {
 struct ExtractStats {
     std::array<std::int64_t, kSubcaseCount> cells_per_subcase{}; ///< cells the surface crosses
     std::int64_t refinement_planes = 0; ///< cmc33_paper: sample planes added (C13 Sec. 6.2); else 0
+    /// Where the mesh's sample planes start (passes.hpp's numbering), nz + 1 entries each, the last
+    /// the totals: plane k's vertices are [plane_first_vertex[k], plane_first_vertex[k + 1]) and cell
+    /// layer k's triangles [plane_first_triangle[k], plane_first_triangle[k + 1]). What
+    /// check_extracted_mesh() (topology.hpp) needs. Empty when cmc33_paper refined the grid.
+    std::vector<std::int64_t> plane_first_vertex, plane_first_triangle;
 };
 
 /// Extracts S = {x : f(x) = iso}, f the trilinear interpolant of the samples.///

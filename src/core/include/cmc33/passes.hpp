@@ -58,6 +58,13 @@ public:
     /// all; ranges counted apart (MPI ranks, out-of-core slabs) get extract()'s normals byte for
     /// byte by doing the same: share_sample_bound(the largest sample_bound() of all ranges).
     double sample_bound() const noexcept { return largest_sample_; }
+    /// The first vertex of sample plane k and the first triangle of cell layer k, counted from the
+    /// range's first (k0 <= k < k1).
+    std::int64_t plane_first_vertex(std::int64_t k) const noexcept { return rows_[static_cast<std::size_t>((k - k0_) * ny_)].xy_first; }
+    std::int64_t plane_first_triangle(std::int64_t k) const noexcept
+    {
+        return rows_[static_cast<std::size_t>((k - k0_) * ny_)].triangle_first;
+    }
     /// Raises the bound to `bound` (never lowers it: a lower bound could overflow the gradients).
     void share_sample_bound(double bound) noexcept { largest_sample_ = bound > largest_sample_ ? bound : largest_sample_; }
 

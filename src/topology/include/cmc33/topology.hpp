@@ -5,6 +5,8 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -70,6 +72,48 @@ struct MeshGeometryOptions {
 /// triangle, then exact tests of the pairs whose boxes overlap); memory about 40 bytes per
 /// triangle. A 2-million-triangle surface takes about a second.
 CMC33_TOPOLOGY_EXPORT MeshGeometry mesh_geometry(const Mesh& mesh, const MeshGeometryOptions& options = {});
+
+/// The grid a mesh was extracted from, and where extract() put each sample plane's vertices and each
+/// cell layer's triangles (ExtractStats::plane_first_vertex and plane_first_triangle).
+struct ExtractedGrid {
+    Index3 dims{};
+    Vec3 spacing{1, 1, 1};
+    Vec3 origin{0, 0, 0};
+    Mat3 direction = kIdentity3;
+    /// dims[2] + 1 entries each: vertices of sample plane k are [first_vertex[k], first_vertex[k + 1]),
+    /// triangles of cell layer k are [first_triangle[k], first_triangle[k + 1]).
+    std::span<const std::int64_t> plane_first_vertex, plane_first_triangle;
+};
+
+/// mesh_topology() and mesh_geometry() of an extracted mesh.
+struct MeshCheck {
+    MeshTopology topology;
+    MeshGeometry geometry;
+    /// True when the grid's structure decided (see check_extracted_mesh()); false when the mesh was
+    /// not laid out as the grid says, or had coincident vertices or a corner outside its cell, and
+    /// the general mesh_topology() and mesh_geometry() ran instead. The numbers are the same.
+    bool structured = false;
+};
+
+struct MeshCheckOptions {
+    int threads = 0;          ///< 0: all cores. The result does not depend on it.
+    std::size_t examples = 8; ///< how many intersecting pairs to list
+    /// Optional: called with the fraction done; false stops the check (Error{cancelled}).
+    std::function<bool(double fraction)> progress;
+};
+
+/// The numbers of mesh_topology() and mesh_geometry() for a mesh extract() made from `grid`,
+/// computed with the grid's structure: every triangle of cell layer k lies in a cell of that layer
+/// (checked: each corner within a quarter cell of it), so only triangles of one cell or of
+/// neighbouring cells can meet, and each vertex's triangles lie in its plane's layer and the one
+/// below. Both checks run slab by slab of planes, in parallel, in memory proportional to a slab
+/// (the topology's slabs merge at their seams as the out-of-core extraction's do). Exact
+/// predicates decide every pair whose boxes meet. A mesh that does not fit the layout, a corner
+/// outside its cell or two vertices at one position send the check to the general functions.
+/// @throws Error{invalid_argument} as mesh_geometry() does; Error{cancelled} if progress said stop.
+/// Cost: O(F) time; memory O(F / slabs).
+CMC33_TOPOLOGY_EXPORT MeshCheck check_extracted_mesh(const Mesh& mesh, const ExtractedGrid& grid,
+                                                     const MeshCheckOptions& options = {});
 
 /// Invariants of S = {x : f(x) = iso} inside the grid's box, f the piecewise-trilinear
 /// interpolant of the samples, computed from the samples alone (no mesh, nothing shared with the

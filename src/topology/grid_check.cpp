@@ -1,0 +1,371 @@
+// The structured geometric check (contract in grid_check.hpp).
+//
+// Layers are processed in blocks, one task per block, whichever thread is free. A block builds, per
+// layer, the list of its triangles sorted by cell (row j, then i), with each triangle's box and
+// whether it is proper (distinct corners, not collinear); then walks the cells of each layer in
+// order and tests every pair of the cell, and of the cell with its 13 neighbours that come after
+// it (the next cell of the row, three of the next row, nine of the next layer), whose boxes meet.
+// Results are kept per block and summed in block order: the same numbers for any thread count.
+
+#include "grid_check.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <string>
+#include <thread>
+#include <utility>
+
+#include "cmc33/error.hpp"
+#include "exact_geometry.hpp"
+
+namespace cmc33::detail {
+namespace {
+
+/// A triangle's bounding box: its corners' floats, exactly.
+struct Box {
+    std::array<float, 3> lo, hi;
+};
+
+bool boxes_meet(const Box& a, const Box& b)
+{
+    return !(a.hi[0] < b.lo[0] || b.hi[0] < a.lo[0] || a.hi[1] < b.lo[1] || b.hi[1] < a.lo[1] || a.hi[2] < b.lo[2] ||
+             b.hi[2] < a.lo[2]);
+}
+
+/// One triangle of a layer, as the pair walk needs it.
+struct Placed {
+    std::int64_t cell;     ///< j * (nx - 1) + i
+    std::int64_t triangle; ///< index into LayeredTriangles::triangles
+    Box box;
+    bool proper;
+    bool operator<(const Placed& o) const { return cell != o.cell ? cell < o.cell : triangle < o.triangle; }
+};
+
+/// The triangles of one layer sorted by cell, with where each row of cells starts.
+struct Layer {
+    std::vector<Placed> placed;
+    std::vector<std::size_t> row_start; ///< ny - 1 + 1 entries
+};
+
+} // namespace
+
+void for_each_block(std::int64_t blocks, int threads, const std::function<void(std::int64_t, const std::atomic<bool>&)>& body,
+                    const std::function<bool()>& tick)
+{
+    std::atomic<std::int64_t> next{0};
+    std::atomic<std::int64_t> finished{0};
+    std::atomic<bool> stop{false};
+    const auto take = [&] {
+        for (std::int64_t b; !stop.load(std::memory_order_relaxed) && (b = next++) < blocks;) {
+            body(b, stop);
+            ++finished;
+        }
+    };
+    const int helpers = static_cast<int>(std::min<std::int64_t>(threads, blocks)) - 1;
+    std::vector<std::exception_ptr> errors(static_cast<std::size_t>(std::max(helpers, 0)) + 1);
+    std::vector<std::thread> pool;
+    for (int t = 0; t < helpers; ++t) {
+        pool.emplace_back([&, t] {
+            try {
+                take();
+            } catch (...) {
+                errors[static_cast<std::size_t>(t) + 1] = std::current_exception();
+                stop = true;
+            }
+        });
+    }
+    bool cancelled = false;
+    try {
+        // the calling thread takes blocks too, and asks `tick` between them and while it waits
+        for (std::int64_t b; !stop.load(std::memory_order_relaxed) && (b = next++) < blocks;) {
+            body(b, stop);
+            ++finished;
+            if (!tick()) {
+                cancelled = true;
+                stop = true;
+            }
+        }
+        while (!stop.load() && finished.load() < blocks) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            if (!tick()) {
+                cancelled = true;
+                stop = true;
+            }
+        }
+    } catch (...) {
+        errors[0] = std::current_exception();
+        stop = true;
+    }
+    for (auto& th : pool) th.join();
+    for (auto& e : errors)
+        if (e) std::rethrow_exception(e);
+    if (cancelled || !tick()) throw Error(Status::cancelled, "the mesh check was cancelled");
+}
+
+namespace {
+
+class Checker {
+public:
+    Checker(const LayeredTriangles& mesh, std::int64_t own, const GridCheckOptions& options)
+        : m_(mesh), own_(own), options_(options)
+    {
+        cells_x_ = m_.dims[0] - 1;
+        cells_y_ = m_.dims[1] - 1;
+        // index = M^-1 (p - origin); M^-1 is the transpose of inverse_transpose(M)
+        const Mat3 it = inverse_transpose(m_.frame);
+        for (std::size_t r = 0; r < 3; ++r)
+            for (std::size_t c = 0; c < 3; ++c) to_index_[r][c] = it[c][r];
+    }
+
+    GridGeometry run()
+    {
+        validate();
+        const std::int64_t layers = own_;
+        GridGeometry total;
+        if (layers <= 0) return total;
+        const int threads = std::max(1, options_.threads);
+        // blocks of a few layers: enough of them to balance threads, few enough that the layer
+        // each block builds twice (its last one's neighbour) stays cheap
+        const std::int64_t blocks = std::clamp<std::int64_t>(layers / 4, 1, 16 * std::int64_t{threads});
+        std::vector<GridGeometry> parts(static_cast<std::size_t>(blocks));
+        std::atomic<std::int64_t> done{0};
+        for_each_block(
+            blocks, threads,
+            [&](std::int64_t b, const std::atomic<bool>& stop) {
+                const std::int64_t z0 = layers * b / blocks, z1 = layers * (b + 1) / blocks;
+                parts[static_cast<std::size_t>(b)] = check_block(z0, z1, stop, done);
+            },
+            [&] { return !options_.progress || options_.progress(done.load()); });
+        for (GridGeometry& p : parts) {
+            total.zero_area_triangles += p.zero_area_triangles;
+            total.intersecting_pairs += p.intersecting_pairs;
+            total.strays += p.strays;
+            total.coincident += p.coincident;
+            total.examples.insert(total.examples.end(), p.examples.begin(), p.examples.end());
+        }
+        std::sort(total.examples.begin(), total.examples.end());
+        if (total.examples.size() > options_.examples) total.examples.resize(options_.examples);
+        return total;
+    }
+
+private:
+    void validate() const
+    {
+        const std::size_t needed = static_cast<std::size_t>(own_ + 1);
+        if (own_ < 0 || m_.layer_first.size() < needed || m_.triangles.size() % 3 != 0 || m_.dims[0] < 2 ||
+            m_.dims[1] < 2 || m_.dims[2] < 2) {
+            throw Error(Status::invalid_argument, "grid_geometry: the layers do not describe the triangles");
+        }
+        for (std::size_t i = 0; i + 1 < m_.layer_first.size(); ++i) {
+            if (m_.layer_first[i] < 0 || m_.layer_first[i] > m_.layer_first[i + 1] ||
+                static_cast<std::size_t>(m_.layer_first[i + 1]) > m_.triangles.size() / 3) {
+                throw Error(Status::invalid_argument, "grid_geometry: layer " + std::to_string(i) +
+                                                          " does not lie within the triangles");
+            }
+        }
+    }
+
+    Point3 position(std::uint32_t v) const
+    {
+        const std::int64_t local = static_cast<std::int64_t>(v) - m_.first_vertex;
+        if (local < 0 || static_cast<std::size_t>(3 * local + 2) >= m_.positions.size()) {
+            throw Error(Status::invalid_argument, "grid_geometry: vertex " + std::to_string(v) + " is not among the " +
+                                                      std::to_string(m_.positions.size() / 3) + " positions given");
+        }
+        const float* p = &m_.positions[static_cast<std::size_t>(3 * local)];
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+            throw Error(Status::invalid_argument, "grid_geometry: vertex " + std::to_string(v) +
+                                                      " has a coordinate that is not a finite number");
+        }
+        // + 0.0 turns -0 into +0, as mesh_geometry() welds them
+        return {static_cast<double>(p[0]) + 0.0, static_cast<double>(p[1]) + 0.0, static_cast<double>(p[2]) + 0.0};
+    }
+
+    Point3 index_of(const Point3& p) const
+    {
+        const double d[3] = {p[0] - m_.origin[0], p[1] - m_.origin[1], p[2] - m_.origin[2]};
+        Point3 q{};
+        for (std::size_t r = 0; r < 3; ++r) q[r] = to_index_[r][0] * d[0] + to_index_[r][1] * d[1] + to_index_[r][2] * d[2];
+        return q;
+    }
+
+    const std::uint32_t* corners(std::int64_t t) const { return &m_.triangles[static_cast<std::size_t>(3 * t)]; }
+
+    /// Layer z's triangles (z relative to k0), placed in their cells; counts strays, coincident
+    /// corners of one triangle and (when `own`) zero-area triangles into `out`.
+    void build(std::int64_t z, bool own, Layer& layer, GridGeometry& out) const
+    {
+        const std::int64_t t0 = m_.layer_first[static_cast<std::size_t>(z)];
+        const std::int64_t t1 = m_.layer_first[static_cast<std::size_t>(z) + 1];
+        layer.placed.clear();
+        layer.placed.reserve(static_cast<std::size_t>(t1 - t0));
+        const double kz = static_cast<double>(m_.k0 + z);
+        for (std::int64_t t = t0; t < t1; ++t) {
+            const std::uint32_t* c = corners(t);
+            const std::array<Point3, 3> p{position(c[0]), position(c[1]), position(c[2])};
+            Point3 q[3];
+            double cx = 0, cy = 0;
+            for (int v = 0; v < 3; ++v) {
+                q[v] = index_of(p[static_cast<std::size_t>(v)]);
+                cx += q[v][0];
+                cy += q[v][1];
+            }
+            const auto ci = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(std::fmax(cx / 3, -1.0))), 0, cells_x_ - 1);
+            const auto cj = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(std::fmax(cy / 3, -1.0))), 0, cells_y_ - 1);
+            const double lo[3] = {static_cast<double>(ci) - kCellMargin, static_cast<double>(cj) - kCellMargin, kz - kCellMargin};
+            bool inside = true;
+            for (int v = 0; v < 3; ++v)
+                for (std::size_t a = 0; a < 3; ++a) {
+                    // NaN-safe: a corner that compares false is outside
+                    if (!(q[v][a] >= lo[a] && q[v][a] <= lo[a] + 1 + 2 * kCellMargin)) inside = false;
+                }
+            const bool repeated = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
+            const bool proper = !repeated && !collinear(p[0], p[1], p[2]);
+            if (own) {
+                if (!inside) ++out.strays;
+                if (!repeated && (p[0] == p[1] || p[1] == p[2] || p[0] == p[2])) ++out.coincident;
+                if (!proper) ++out.zero_area_triangles;
+            }
+            Placed e{cj * cells_x_ + ci, t, {}, proper};
+            for (std::size_t a = 0; a < 3; ++a) {
+                // the doubles hold floats exactly
+                e.box.lo[a] = static_cast<float>(std::min({p[0][a], p[1][a], p[2][a]}));
+                e.box.hi[a] = static_cast<float>(std::max({p[0][a], p[1][a], p[2][a]}));
+            }
+            layer.placed.push_back(e);
+        }
+        // extract() writes triangles cell by cell: nearly sorted already
+        if (!std::is_sorted(layer.placed.begin(), layer.placed.end())) std::sort(layer.placed.begin(), layer.placed.end());
+        layer.row_start.assign(static_cast<std::size_t>(cells_y_) + 1, 0);
+        std::size_t at = 0;
+        for (std::int64_t j = 0; j <= cells_y_; ++j) {
+            while (at < layer.placed.size() && layer.placed[at].cell < j * cells_x_) ++at;
+            layer.row_start[static_cast<std::size_t>(j)] = at;
+        }
+    }
+
+    /// Tests the pair (a, b) of different triangles; counts what it finds into `out`.
+    void test_pair(const Placed& a, const Placed& b, GridGeometry& out) const
+    {
+        if (!boxes_meet(a.box, b.box)) return;
+        const std::uint32_t* a_ids = corners(a.triangle);
+        const std::uint32_t* b_ids = corners(b.triangle);
+        const std::array<Point3, 3> a_points{position(a_ids[0]), position(a_ids[1]), position(a_ids[2])};
+        const std::array<Point3, 3> b_points{position(b_ids[0]), position(b_ids[1]), position(b_ids[2])};
+        // corners of b that a has too (by id), and distinct ids at one position
+        int match[3] = {-1, -1, -1};
+        int shared = 0;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+                if (a_ids[ui] == b_ids[uj]) {
+                    match[i] = j;
+                    ++shared;
+                } else if (a_points[ui] == b_points[uj]) {
+                    ++out.coincident;
+                }
+            }
+        if (!a.proper || !b.proper) return;
+        // shared corners first, in the same order in both
+        std::array<Point3, 3> pa{}, pb{};
+        int at = 0;
+        bool used[3] = {false, false, false};
+        for (int i = 0; i < 3; ++i)
+            if (match[i] >= 0) {
+                pa[static_cast<std::size_t>(at)] = a_points[static_cast<std::size_t>(i)];
+                pb[static_cast<std::size_t>(at)] = b_points[static_cast<std::size_t>(match[i])];
+                used[match[i]] = true;
+                ++at;
+            }
+        for (int i = 0, ka = at, kb = at; i < 3; ++i) {
+            if (match[i] < 0) pa[static_cast<std::size_t>(ka++)] = a_points[static_cast<std::size_t>(i)];
+            if (!used[i]) pb[static_cast<std::size_t>(kb++)] = b_points[static_cast<std::size_t>(i)];
+        }
+        const bool meets = shared == 3 || triangles_meet_improperly(pa, pb, shared);
+        if (!meets) return;
+        ++out.intersecting_pairs;
+        const std::int64_t x = m_.first_triangle + a.triangle, y = m_.first_triangle + b.triangle;
+        out.examples.push_back({std::min(x, y), std::max(x, y)});
+        if (out.examples.size() > 4 * options_.examples + 64) {
+            std::sort(out.examples.begin(), out.examples.end());
+            out.examples.resize(options_.examples);
+        }
+    }
+
+    /// Entries of `layer` in row j with cells i0..i1 (clamped to the grid).
+    std::pair<const Placed*, const Placed*> cells_of(const Layer& layer, std::int64_t j, std::int64_t i0,
+                                                     std::int64_t i1) const
+    {
+        if (j < 0 || j >= cells_y_) return {nullptr, nullptr};
+        i0 = std::max<std::int64_t>(i0, 0);
+        i1 = std::min<std::int64_t>(i1, cells_x_ - 1);
+        const Placed* first = layer.placed.data() + layer.row_start[static_cast<std::size_t>(j)];
+        const Placed* last = layer.placed.data() + layer.row_start[static_cast<std::size_t>(j) + 1];
+        const std::int64_t lo = j * cells_x_ + i0, hi = j * cells_x_ + i1;
+        first = std::partition_point(first, last, [lo](const Placed& e) { return e.cell < lo; });
+        const Placed* end = first;
+        while (end < last && end->cell <= hi) ++end;
+        return {first, end};
+    }
+
+    /// Every pair of `own` (layer z) with itself and with `above` (layer z + 1, or null).
+    void walk(const Layer& own, const Layer* above, GridGeometry& out) const
+    {
+        const auto& placed = own.placed;
+        for (std::size_t g = 0; g < placed.size();) {
+            std::size_t h = g + 1;
+            while (h < placed.size() && placed[h].cell == placed[g].cell) ++h;
+            const std::int64_t cell = placed[g].cell, j = cell / cells_x_, i = cell % cells_x_;
+            const auto with = [&](std::pair<const Placed*, const Placed*> range) {
+                for (std::size_t a = g; a < h; ++a)
+                    for (const Placed* b = range.first; b != range.second; ++b) test_pair(placed[a], *b, out);
+            };
+            for (std::size_t a = g; a < h; ++a)
+                for (std::size_t b = a + 1; b < h; ++b) test_pair(placed[a], placed[b], out);
+            // the cells after this one: (i + 1, j), (i - 1 .. i + 1, j + 1), and the nine above
+            with(cells_of(own, j, i + 1, i + 1));
+            with(cells_of(own, j + 1, i - 1, i + 1));
+            if (above) {
+                for (std::int64_t dj = -1; dj <= 1; ++dj) with(cells_of(*above, j + dj, i - 1, i + 1));
+            }
+            g = h;
+        }
+    }
+
+    GridGeometry check_block(std::int64_t z0, std::int64_t z1, const std::atomic<bool>& stop,
+                             std::atomic<std::int64_t>& done) const
+    {
+        GridGeometry out;
+        Layer current, next;
+        build(z0, true, current, out);
+        const std::int64_t available = static_cast<std::int64_t>(m_.layer_first.size()) - 1;
+        for (std::int64_t z = z0; z < z1; ++z) {
+            if (stop.load(std::memory_order_relaxed)) break;
+            const bool has_above = z + 1 < available;
+            if (has_above) build(z + 1, z + 1 < z1, next, out);
+            walk(current, has_above ? &next : nullptr, out);
+            std::swap(current, next);
+            ++done;
+        }
+        return out;
+    }
+
+    const LayeredTriangles& m_;
+    std::int64_t own_;
+    GridCheckOptions options_;
+    std::int64_t cells_x_ = 1, cells_y_ = 1;
+    Mat3 to_index_{};
+};
+
+} // namespace
+
+GridGeometry grid_geometry(const LayeredTriangles& mesh, std::int64_t own, const GridCheckOptions& options)
+{
+    return Checker(mesh, own, options).run();
+}
+
+} // namespace cmc33::detail
