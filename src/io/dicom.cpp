@@ -7,6 +7,7 @@
 // deflate).
 
 #include "dicom.hpp"
+#include "dicom_scan.hpp"
 #include "tiff.hpp"
 
 #include <algorithm>
@@ -330,6 +331,7 @@ struct Header {
     std::int64_t frames = 1;
     std::vector<Geometry> geometry; // one per frame
     std::optional<std::uint64_t> native_offset; // native transfer syntaxes: the first sample's byte
+    std::uint64_t pixel_bytes = 0; // the Pixel Data's bytes (encapsulated: its fragments'), from scan_dicom
 };
 
 /// One input file: a path, or bytes in memory.
@@ -411,6 +413,13 @@ std::string source_bytes(const Source& source, std::uint64_t offset, std::uint64
     return file.read_string(offset, count);
 }
 
+/// The element structure of a source checked before GDCM sees it (dicom_scan.hpp).
+DicomLayout scan(const Source& source)
+{
+    if (source.in_memory) return scan_dicom(MemoryInput(source.bytes, source.label));
+    return scan_dicom(InputFile(source.path, source.label));
+}
+
 /// Reads a file's header up to its Pixel Data (GDCM reads no further).
 Header read_header(const Source& source, std::size_t index)
 {
@@ -418,13 +427,14 @@ Header read_header(const Source& source, std::size_t index)
     Header h;
     h.source = index;
     h.label = source.label;
+    h.pixel_bytes = scan(source).pixel_bytes;
     gdcm::Reader reader;
     std::unique_ptr<std::istringstream> stream;
     open(reader, source, stream);
     bool ok = false;
     try {
         ok = reader.ReadUpToTag(kPixelData);
-    } catch (const std::exception&) {
+    } catch (...) { // GDCM also throws plain strings
         ok = false;
     }
     if (!ok) {
@@ -503,6 +513,21 @@ Header read_header(const Source& source, std::size_t index)
                                 size, " bytes (file cut short, or a wrong NumberOfFrames?)"));
         }
     }
+    // GDCM's decoders allocate what Rows x Columns x frames declare: a compressed Pixel Data must
+    // be able to hold it. Real images compress a few times; 1024:1 leaves room for near-constant
+    // ones and keeps a crafted header from asking for gigabytes out of a few bytes.
+    if (!is_native(h.ts) && h.has_pixels) {
+        constexpr std::uint64_t kMaxRatio = 1024;
+        const std::uint64_t declared = std::uint64_t{h.rows} * h.columns * std::max(1u, h.samples_per_pixel) *
+                                       ((h.bits_allocated + 7) / 8) * static_cast<std::uint64_t>(h.frames);
+        if (declared > kMaxRatio * std::max<std::uint64_t>(h.pixel_bytes, 1)) {
+            throw Error(Status::bad_format,
+                        str_cat(source.label, ": ", h.frames, " frame", h.frames == 1 ? "" : "s", " of ", h.columns, "x", h.rows, " pixels (",
+                                h.samples_per_pixel, " sample", h.samples_per_pixel == 1 ? "" : "s", ", ", h.bits_allocated, " bits allocated) take ",
+                                declared, " bytes but the compressed Pixel Data holds ", h.pixel_bytes,
+                                "; expected at most 1024 times its size (a wrong Rows, Columns or NumberOfFrames?)"));
+        }
+    }
     Geometry top;
     read_geometry(ds, top);
     if (!top.pixel_spacing) {
@@ -510,9 +535,17 @@ Header read_header(const Source& source, std::size_t index)
             top.pixel_spacing = std::array<double, 2>{(*s)[0], (*s)[1]};
     }
     std::vector<gdcm::SmartPointer<gdcm::SequenceOfItems>> keep;
-    if (const gdcm::DataSet* shared = first_item(ds, kSharedGroups, keep)) read_functional_groups(*shared, top);
     gdcm::SmartPointer<gdcm::SequenceOfItems> per_frame;
-    if (ds.FindDataElement(kPerFrameGroups)) per_frame = ds.GetDataElement(kPerFrameGroups).GetValueAsSQ();
+    try {
+        // GDCM parses a sequence held as bytes (Implicit VR, UN) only when asked, and may throw
+        // plain strings doing so
+        if (const gdcm::DataSet* shared = first_item(ds, kSharedGroups, keep)) read_functional_groups(*shared, top);
+        if (ds.FindDataElement(kPerFrameGroups)) per_frame = ds.GetDataElement(kPerFrameGroups).GetValueAsSQ();
+    } catch (const Error&) {
+        throw;
+    } catch (...) {
+        throw Error(Status::bad_format, source.label + ": GDCM cannot read the functional groups sequences (5200,9229) and (5200,9230)");
+    }
     if (per_frame && per_frame->GetNumberOfItems() > 0) {
         if (static_cast<std::int64_t>(per_frame->GetNumberOfItems()) != h.frames) {
             throw Error(Status::bad_format,
@@ -520,10 +553,16 @@ Header read_header(const Source& source, std::size_t index)
                                 " items but NumberOfFrames is ", h.frames, "; expected one item per frame"));
         }
         h.geometry.reserve(static_cast<std::size_t>(h.frames));
-        for (std::size_t f = 1; f <= per_frame->GetNumberOfItems(); ++f) {
-            Geometry g = top;
-            read_functional_groups(per_frame->GetItem(f).GetNestedDataSet(), g);
-            h.geometry.push_back(g);
+        try {
+            for (std::size_t f = 1; f <= per_frame->GetNumberOfItems(); ++f) {
+                Geometry g = top;
+                read_functional_groups(per_frame->GetItem(f).GetNestedDataSet(), g);
+                h.geometry.push_back(g);
+            }
+        } catch (const Error&) {
+            throw;
+        } catch (...) {
+            throw Error(Status::bad_format, source.label + ": GDCM cannot read the per-frame functional groups sequence (5200,9230)");
         }
     } else if (h.frames == 1) {
         h.geometry.push_back(top);
@@ -862,7 +901,7 @@ void read_stored(const std::vector<Slice>& slices, const std::vector<Source>& so
             bool ok = false;
             try {
                 ok = reader.Read();
-            } catch (const std::exception&) {
+            } catch (...) { // GDCM also throws plain strings
                 ok = false;
             }
             if (!ok) throw Error(Status::bad_format, h.label + ": GDCM cannot read the image (corrupt or unsupported Pixel Data)");
@@ -878,7 +917,7 @@ void read_stored(const std::vector<Slice>& slices, const std::vector<Source>& so
             bool decoded_ok = false;
             try {
                 decoded_ok = image.GetBuffer(buffer.data());
-            } catch (const std::exception&) {
+            } catch (...) { // GDCM also throws plain strings
                 decoded_ok = false;
             }
             if (!decoded_ok) {
@@ -1029,19 +1068,25 @@ Volume build_volume(const std::vector<const Header*>& files, const std::vector<S
 std::vector<fs::path> dicomdir_files(const fs::path& dicomdir)
 {
     quiet_gdcm();
+    scan_dicom(InputFile(dicomdir, dicomdir.string()));
     gdcm::Reader reader;
     reader.SetFileName(dicomdir.c_str());
     bool ok = false;
     try {
         ok = reader.Read();
-    } catch (const std::exception&) {
+    } catch (...) { // GDCM also throws plain strings
         ok = false;
     }
     if (!ok) throw Error(Status::bad_format, dicomdir.string() + ": not a DICOMDIR GDCM can read");
     const gdcm::DataSet& ds = reader.GetFile().GetDataSet();
     std::vector<fs::path> files;
     if (!ds.FindDataElement(kDirectoryRecords)) return files;
-    gdcm::SmartPointer<gdcm::SequenceOfItems> records = ds.GetDataElement(kDirectoryRecords).GetValueAsSQ();
+    gdcm::SmartPointer<gdcm::SequenceOfItems> records;
+    try {
+        records = ds.GetDataElement(kDirectoryRecords).GetValueAsSQ();
+    } catch (...) {
+        throw Error(Status::bad_format, dicomdir.string() + ": GDCM cannot read the DirectoryRecordSequence (0004,1220)");
+    }
     if (!records) return files;
     for (std::size_t i = 1; i <= records->GetNumberOfItems(); ++i) {
         const std::string id = text_value(records->GetItem(i).GetNestedDataSet(), kReferencedFileId);

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <initializer_list>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -19,12 +21,14 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/io.hpp"
 #include "dicom.hpp"
+#include "dicom_scan.hpp"
 #include "test_support.hpp"
 
 namespace cmc33 {
 namespace {
 
 namespace fs = std::filesystem;
+using namespace std::string_literals;
 
 /// The series write_dicom.py writes, once for the whole suite.
 const fs::path& series_dir()
@@ -247,6 +251,196 @@ TEST_F(Dicom, NotDicomIsRefusedNamingTheFile)
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("a.dcm: not a DICOM file"), std::string::npos) << e.what();
     }
+}
+
+// ---- the element structure, checked before GDCM parses (src/io/dicom_scan.cpp) --------------
+
+/// Builds DICOM Part 10 bytes: preamble, "DICM", a file meta group naming `syntax`, then elements
+/// in Explicit VR Little Endian appended with the helpers.
+class DicomBytes {
+public:
+    explicit DicomBytes(const std::string& syntax = "1.2.840.10008.1.2.1")
+    {
+        bytes_.assign(128, '\0');
+        bytes_ += "DICM";
+        std::string uid = syntax;
+        if (uid.size() % 2) uid += '\0';
+        element(0x0002, 0x0010, "UI", uid);
+    }
+    /// An element with a 16- or 32-bit length field as its VR has (PS3.5 7.1.2).
+    DicomBytes& element(std::uint16_t group, std::uint16_t elem, const char* vr, const std::string& value)
+    {
+        return header(group, elem, vr, static_cast<std::uint32_t>(value.size())).raw(value);
+    }
+    /// Only the header: a declared length that the bytes need not follow.
+    DicomBytes& header(std::uint16_t group, std::uint16_t elem, const char* vr, std::uint32_t length)
+    {
+        u16(group).u16(elem);
+        bytes_ += vr;
+        const std::string v(vr);
+        if (v == "OB" || v == "OW" || v == "SQ" || v == "UN" || v == "UT" || v == "UC" || v == "UR" || v == "OF" || v == "OD" ||
+            v == "OL" || v == "OV" || v == "SV" || v == "UV") {
+            u16(0).u32(length);
+        } else {
+            u16(static_cast<std::uint16_t>(length));
+        }
+        return *this;
+    }
+    /// An item or delimiter tag (FFFE,xxxx) with its 32-bit length.
+    DicomBytes& item(std::uint16_t elem, std::uint32_t length) { return u16(0xFFFE).u16(elem).u32(length); }
+    DicomBytes& raw(const std::string& b)
+    {
+        bytes_ += b;
+        return *this;
+    }
+    DicomBytes& u16(std::uint16_t v)
+    {
+        bytes_ += static_cast<char>(v & 0xff);
+        bytes_ += static_cast<char>(v >> 8);
+        return *this;
+    }
+    DicomBytes& u32(std::uint32_t v) { return u16(static_cast<std::uint16_t>(v & 0xffff)).u16(static_cast<std::uint16_t>(v >> 16)); }
+    const std::string& bytes() const { return bytes_; }
+
+private:
+    std::string bytes_;
+};
+
+/// A 2x2 16-bit image with every attribute the reader needs but a second slice.
+DicomBytes image()
+{
+    DicomBytes d;
+    d.element(0x0008, 0x0060, "CS", "CT")
+        .element(0x0020, 0x000e, "UI", "1.2.3.4\0"s)
+        .element(0x0020, 0x0032, "DS", "0\\0\\0 ")
+        .element(0x0020, 0x0037, "DS", "1\\0\\0\\0\\1\\0 ")
+        .header(0x0028, 0x0010, "US", 2).u16(2)
+        .header(0x0028, 0x0011, "US", 2).u16(2)
+        .header(0x0028, 0x0100, "US", 2).u16(16)
+        .header(0x0028, 0x0101, "US", 2).u16(16)
+        .header(0x0028, 0x0102, "US", 2).u16(15)
+        .header(0x0028, 0x0103, "US", 2).u16(0)
+        .element(0x7fe0, 0x0010, "OW", std::string(8, '\x01'));
+    return d;
+}
+
+/// The error reading `bytes` from memory as "mem.dcm" ("(no error)" if it reads).
+std::string memory_error(const std::string& bytes)
+{
+    try {
+        (void)io::read_volume_from_memory(bytes, io::VolumeFormat::dicom, "mem.dcm");
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+class DicomScan : public ::testing::Test {
+protected:
+    void SetUp() override
+    {
+        if (!io::detail::dicom_supported()) GTEST_SKIP() << "this build has no DICOM reader (GDCM not found)";
+    }
+    /// The message is one line naming the file and holding every one of `parts`.
+    static void expect_error(const std::string& bytes, std::initializer_list<std::string> parts)
+    {
+        const std::string m = memory_error(bytes);
+        EXPECT_EQ(m.rfind("mem.dcm: ", 0), 0u) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+        for (const std::string& p : parts) EXPECT_NE(m.find(p), std::string::npos) << "missing \"" << p << "\" in: " << m;
+    }
+};
+
+TEST_F(DicomScan, TheReferenceImageGetsPastTheScan)
+{
+    // one slice: refused by the reader for that reason, after GDCM parsed it
+    EXPECT_NE(memory_error(image().bytes()).find("the series has 1 slice"), std::string::npos) << memory_error(image().bytes());
+}
+
+TEST_F(DicomScan, DeclaredLengthBeyondTheFile)
+{
+    DicomBytes d = image();
+    d.header(0x0042, 0x0011, "OB", 0xFFFFFFF0u).raw(std::string(16, 'x'));
+    expect_error(d.bytes(), {"(0042,0011)", "value length 4294967280 passes the end of the file (16 bytes remain)", "at byte "});
+}
+
+TEST_F(DicomScan, DeclaredLengthBeyondItsItem)
+{
+    DicomBytes d;
+    d.header(0x0008, 0x1140, "SQ", 0xFFFFFFFFu).item(0xE000, 12).header(0x0008, 0x1150, "UI", 40).raw("1.2\0"s).item(0xE0DD, 0);
+    expect_error(d.bytes(), {"(0008,1150)", "value length 40 passes the end of the enclosing item (4 bytes remain)"});
+}
+
+TEST_F(DicomScan, SequencesNestedTooDeep)
+{
+    DicomBytes d;
+    const int levels = io::detail::kMaxDicomNesting + 2;
+    for (int i = 0; i < levels; ++i) d.header(0x0008, 0x1140, "SQ", 0xFFFFFFFFu).item(0xE000, 0xFFFFFFFFu);
+    for (int i = 0; i < levels; ++i) d.item(0xE00D, 0).item(0xE0DD, 0);
+    expect_error(d.bytes(), {"(0008,1140)", "sequences nested more than 32 deep"});
+}
+
+TEST_F(DicomScan, UndefinedLengthOnANonSequence)
+{
+    DicomBytes d = image();
+    d.header(0x0008, 0x0081, "UT", 0xFFFFFFFFu).raw("abcd");
+    expect_error(d.bytes(), {"(0008,0081)", "undefined value length (FFFFFFFFH) on VR UT"});
+}
+
+TEST_F(DicomScan, BadVrOddLengthAndStrayDelimiters)
+{
+    expect_error(DicomBytes().header(0x0008, 0x0060, "QQ", 2).raw("CT").bytes(), {"(0008,0060)", "VR \"QQ\""});
+    expect_error(DicomBytes().element(0x0008, 0x0060, "CS", "CTX").bytes(), {"(0008,0060)", "odd value length 3"});
+    expect_error(DicomBytes().item(0xE0DD, 0).bytes(), {"(fffe,e0dd)", "a Sequence Delimitation Item among data elements"});
+    expect_error(DicomBytes().header(0x0028, 0x0010, "US", 4).u32(0).header(0x0028, 0x0011, "US", 3).raw("abc").bytes(),
+                 {"(0028,0011)", "odd value length 3"});
+}
+
+TEST_F(DicomScan, EncapsulatedPixelData)
+{
+    // RLE: the Basic Offset Table, one fragment, no delimiter
+    DicomBytes d("1.2.840.10008.1.2.5");
+    d.header(0x7fe0, 0x0010, "OB", 0xFFFFFFFFu).item(0xE000, 0).item(0xE000, 4).raw("abcd");
+    expect_error(d.bytes(), {"encapsulated Pixel Data", "without its Sequence Delimitation Item"});
+    // a fragment longer than the file
+    DicomBytes e("1.2.840.10008.1.2.5");
+    e.header(0x7fe0, 0x0010, "OB", 0xFFFFFFFFu).item(0xE000, 0).item(0xE000, 1000).raw("abcd");
+    expect_error(e.bytes(), {"(fffe,e000)", "value length 1000 passes the end of the file"});
+    // native syntax with undefined-length Pixel Data
+    DicomBytes f;
+    f.header(0x7fe0, 0x0010, "OB", 0xFFFFFFFFu).item(0xE000, 0).item(0xE0DD, 0);
+    expect_error(f.bytes(), {"(7fe0,0010)", "undefined length in a native transfer syntax"});
+}
+
+TEST_F(DicomScan, DeflatedAndUnknownSyntaxesAreRefusedByName)
+{
+    expect_error(DicomBytes("1.2.840.10008.1.2.1.99").bytes(), {"Deflated Explicit VR Little Endian"});
+    expect_error(DicomBytes("1.2.3.4").bytes(), {"transfer syntax \"1.2.3.4\" is not read"});
+}
+
+TEST_F(DicomScan, TruncatedFilesGiveOneLine)
+{
+    const std::string whole = image().bytes();
+    for (std::size_t cut : {std::size_t{0}, std::size_t{100}, std::size_t{131}, std::size_t{133}, std::size_t{140}, std::size_t{160},
+                            whole.size() / 2, whole.size() - 9, whole.size() - 3, whole.size() - 1}) {
+        SCOPED_TRACE(cut);
+        const std::string m = memory_error(whole.substr(0, cut));
+        EXPECT_EQ(m.rfind("mem.dcm: ", 0), 0u) << m;
+        EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+    // every prefix: an error, never a crash
+    for (std::size_t cut = 0; cut < whole.size(); ++cut) EXPECT_NE(memory_error(whole.substr(0, cut)), "(no error)") << cut;
+}
+
+TEST_F(DicomScan, CompressedPixelDataMustHoldTheDeclaredSamples)
+{
+    DicomBytes d("1.2.840.10008.1.2.5");
+    d.element(0x0008, 0x0060, "CS", "CT")
+        .header(0x0028, 0x0010, "US", 2).u16(60000)
+        .header(0x0028, 0x0011, "US", 2).u16(60000)
+        .header(0x0028, 0x0100, "US", 2).u16(16)
+        .header(0x7fe0, 0x0010, "OB", 0xFFFFFFFFu).item(0xE000, 0).item(0xE000, 64).raw(std::string(64, '\0')).item(0xE0DD, 0);
+    expect_error(d.bytes(), {"60000x60000 pixels", "the compressed Pixel Data holds 64", "at most 1024 times"});
 }
 
 } // namespace
