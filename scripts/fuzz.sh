@@ -15,7 +15,7 @@ if [[ $# -gt 0 && "$1" =~ ^[0-9]+$ ]]; then
     seconds=$1
     shift
 fi
-all=(nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff)
+all=(nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff nifti npy vti)
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=("${all[@]}")
 for t in "${targets[@]}"; do
@@ -34,15 +34,17 @@ fi
 runs=()
 [[ -n "${FUZZ_RUNS:-}" ]] && runs=(-runs="$FUZZ_RUNS")
 failed=0
-printf '%-6s %12s %8s %6s %6s %8s\n' target execs seconds cov ft crashes
-for t in "${targets[@]}"; do
-    work=build-fuzz/fuzz-work/$t
+# One target per core at a time (two at once on CI's two cores); the table is printed in order.
+jobs=${FUZZ_JOBS:-2}
+fuzz_one() {
+    local t=$1 work=build-fuzz/fuzz-work/$1
     rm -rf "$work/corpus"
     mkdir -p "$work/corpus" "$work/artifacts"
+    rm -f "$work/result" "$work/crashes"
     cp fuzz/corpus/"$t"/* "$work/corpus/"
+    local before start status=0 elapsed execs last cov ft crashes
     before=$(find "$work/artifacts" -type f | wc -l)
     start=$(date +%s)
-    status=0
     build-fuzz/fuzz/fuzz_"$t" -max_total_time="$seconds" "${runs[@]}" -rss_limit_mb=2048 \
         -malloc_limit_mb=256 -timeout=10 -print_final_stats=1 \
         -artifact_prefix="$work/artifacts/" "$work/corpus" >"$work/log" 2>&1 || status=$?
@@ -53,8 +55,19 @@ for t in "${targets[@]}"; do
     ft=$(sed -n 's/.* ft: \([0-9]*\).*/\1/p' <<<"$last")
     crashes=$(( $(find "$work/artifacts" -type f | wc -l) - before ))
     [[ $status -ne 0 && $crashes -eq 0 ]] && crashes=1 # died without an artifact
-    printf '%-6s %12s %8s %6s %6s %8s\n' "$t" "${execs:-?}" "$elapsed" "${cov:-?}" "${ft:-?}" "$crashes"
-    if [[ $crashes -ne 0 ]]; then
+    printf '%-6s %12s %8s %6s %6s %8s\n' "$t" "${execs:-?}" "$elapsed" "${cov:-?}" "${ft:-?}" "$crashes" >"$work/result"
+    echo "$crashes" >"$work/crashes"
+}
+for t in "${targets[@]}"; do
+    while [[ $(jobs -rp | wc -l) -ge $jobs ]]; do wait -n || true; done
+    fuzz_one "$t" &
+done
+wait
+printf '%-6s %12s %8s %6s %6s %8s\n' target execs seconds cov ft crashes
+for t in "${targets[@]}"; do
+    work=build-fuzz/fuzz-work/$t
+    cat "$work/result" 2>/dev/null || echo "$t: no result"
+    if [[ "$(cat "$work/crashes" 2>/dev/null || echo 1)" != 0 ]]; then
         failed=1
         echo "  see $work/log; inputs in $work/artifacts/" >&2
     fi

@@ -94,7 +94,8 @@ TEST(VolumeErrors, DirectoryAndFifo)
 {
     const auto dir = temp_dir();
     std::filesystem::create_directories(dir / "folder.nrrd");
-    expect_read_error(dir / "folder.nrrd", Status::io_error, {"is a directory"});
+    // a folder is a DICOM series or a TIFF stack: one with neither is refused saying what was expected
+    expect_read_error(dir / "folder.nrrd", Status::unsupported_format, {"a folder without DICOM files", "expected"});
     // A FIFO must be refused, not waited on.
     ASSERT_EQ(::mkfifo((dir / "pipe.vtk").c_str(), 0600), 0);
     expect_read_error(dir / "pipe.vtk", Status::io_error, {"not a regular file"});
