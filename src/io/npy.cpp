@@ -68,7 +68,7 @@ public:
                 h.shape = tuple();
                 has_shape = true;
             } else {
-                fail("unknown key \"" + key + "\"; expected 'descr', 'fortran_order' and 'shape'");
+                fail("unknown key " + quote_bytes(key) + "; expected 'descr', 'fortran_order' and 'shape'");
             }
             skip_blanks();
             if (peek() == ',') {

@@ -87,7 +87,7 @@ std::optional<Tag> find_tag(std::string_view text, std::string_view name, std::s
         const std::string key(trim(text.substr(i, eq - i)));
         const std::size_t close = text.find(text[eq + 1], eq + 2);
         if (close == std::string_view::npos) {
-            throw Error(Status::truncated_file, str_cat(label, ": the attribute ", key, " of <", name, "> is not closed"));
+            throw Error(Status::truncated_file, str_cat(label, ": the attribute ", quote_bytes(key), " of <", name, "> is not closed"));
         }
         tag.attributes.emplace_back(key, std::string(text.substr(eq + 2, close - eq - 2)));
         i = close + 1;
@@ -295,7 +295,7 @@ Volume read_vti(const ByteInput& file, const ReadOptions& options)
     }
     const std::string array_name = chosen->get("Name").value_or("");
     if (const auto components = chosen->get("NumberOfComponents"); components && *components != "1") {
-        throw Error(Status::unsupported_format, str_cat(label, ": point-data array ", quote_bytes(array_name), " has ", *components,
+        throw Error(Status::unsupported_format, str_cat(label, ": point-data array ", quote_bytes(array_name), " has ", quote_bytes(*components),
                                                         " components per point; cmc33 meshes one scalar per point"));
     }
     const std::string type_name_text = chosen->get("type").value_or("");
