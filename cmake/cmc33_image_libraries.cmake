@@ -13,13 +13,14 @@ if(NOT DEFINED CMC33_WITH_GDCM OR CMC33_WITH_GDCM)
     find_library(CMC33_GDCM_MSFF gdcmMSFF)
     find_library(CMC33_GDCM_DSED gdcmDSED)
     find_library(CMC33_GDCM_COMMON gdcmCommon)
-    if(CMC33_GDCM_INCLUDE_DIR AND CMC33_GDCM_MSFF AND CMC33_GDCM_DSED AND CMC33_GDCM_COMMON)
+    find_library(CMC33_GDCM_DICT gdcmDICT) # the data dictionary: src/io/dicom.cpp judges VRs against it
+    if(CMC33_GDCM_INCLUDE_DIR AND CMC33_GDCM_MSFF AND CMC33_GDCM_DSED AND CMC33_GDCM_COMMON AND CMC33_GDCM_DICT)
         set(CMC33_HAVE_GDCM ON)
         if(NOT TARGET cmc33_gdcm)
             add_library(cmc33_gdcm INTERFACE IMPORTED GLOBAL)
             set_target_properties(cmc33_gdcm PROPERTIES
                 INTERFACE_INCLUDE_DIRECTORIES "${CMC33_GDCM_INCLUDE_DIR}"
-                INTERFACE_LINK_LIBRARIES "${CMC33_GDCM_MSFF};${CMC33_GDCM_DSED};${CMC33_GDCM_COMMON}")
+                INTERFACE_LINK_LIBRARIES "${CMC33_GDCM_MSFF};${CMC33_GDCM_DICT};${CMC33_GDCM_DSED};${CMC33_GDCM_COMMON}")
         endif()
     endif()
 endif()
