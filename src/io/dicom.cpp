@@ -33,6 +33,9 @@
 
 #if CMC33_WITH_GDCM
 #include <gdcmDataSet.h>
+#include <gdcmDictEntry.h>
+#include <gdcmDicts.h>
+#include <gdcmGlobal.h>
 #include <gdcmFile.h>
 #include <gdcmImage.h>
 #include <gdcmImageReader.h>
@@ -331,7 +334,7 @@ struct Header {
     std::int64_t frames = 1;
     std::vector<Geometry> geometry; // one per frame
     std::optional<std::uint64_t> native_offset; // native transfer syntaxes: the first sample's byte
-    std::uint64_t pixel_bytes = 0; // the Pixel Data's bytes (encapsulated: its fragments'), from scan_dicom
+    DicomLayout layout; // from scan_dicom
 };
 
 /// One input file: a path, or bytes in memory.
@@ -413,11 +416,27 @@ std::string source_bytes(const Source& source, std::uint64_t offset, std::uint64
     return file.read_string(offset, count);
 }
 
+/// GDCM reads image attributes through typed accessors that assert when an element's VR is not
+/// the data dictionary's (PS3.6): such a VR is refused first. Private tags are not judged.
+std::string dictionary_vr(std::uint16_t group, std::uint16_t element, std::string_view vr)
+{
+    if (group % 2 != 0) return {};
+    // repeating groups (overlays 60xx, curves 50xx) are listed under their first group
+    const std::uint16_t base = (group & 0xFF00) == 0x6000 || (group & 0xFF00) == 0x5000 ? static_cast<std::uint16_t>(group & 0xFF00) : group;
+    const gdcm::DictEntry& entry = gdcm::Global::GetInstance().GetDicts().GetDictEntry(gdcm::Tag(base, element));
+    const gdcm::VR expected = entry.GetVR();
+    if (expected == gdcm::VR::INVALID || expected == gdcm::VR::VR_END) return {};
+    const std::string code(vr);
+    if (expected.Compatible(gdcm::VR(gdcm::VR::GetVRTypeFromFile(code.c_str())))) return {};
+    const char* name = gdcm::VR::GetVRString(expected);
+    return name ? name : "the data dictionary's VR";
+}
+
 /// The element structure of a source checked before GDCM sees it (dicom_scan.hpp).
 DicomLayout scan(const Source& source)
 {
-    if (source.in_memory) return scan_dicom(MemoryInput(source.bytes, source.label));
-    return scan_dicom(InputFile(source.path, source.label));
+    if (source.in_memory) return scan_dicom(MemoryInput(source.bytes, source.label), dictionary_vr);
+    return scan_dicom(InputFile(source.path, source.label), dictionary_vr);
 }
 
 /// Reads a file's header up to its Pixel Data (GDCM reads no further).
@@ -427,7 +446,7 @@ Header read_header(const Source& source, std::size_t index)
     Header h;
     h.source = index;
     h.label = source.label;
-    h.pixel_bytes = scan(source).pixel_bytes;
+    h.layout = scan(source);
     gdcm::Reader reader;
     std::unique_ptr<std::istringstream> stream;
     open(reader, source, stream);
@@ -520,13 +539,19 @@ Header read_header(const Source& source, std::size_t index)
         constexpr std::uint64_t kMaxRatio = 1024;
         const std::uint64_t declared = std::uint64_t{h.rows} * h.columns * std::max(1u, h.samples_per_pixel) *
                                        ((h.bits_allocated + 7) / 8) * static_cast<std::uint64_t>(h.frames);
-        if (declared > kMaxRatio * std::max<std::uint64_t>(h.pixel_bytes, 1)) {
+        if (declared > kMaxRatio * std::max<std::uint64_t>(h.layout.pixel_bytes, 1)) {
             throw Error(Status::bad_format,
                         str_cat(source.label, ": ", h.frames, " frame", h.frames == 1 ? "" : "s", " of ", h.columns, "x", h.rows, " pixels (",
                                 h.samples_per_pixel, " sample", h.samples_per_pixel == 1 ? "" : "s", ", ", h.bits_allocated, " bits allocated) take ",
-                                declared, " bytes but the compressed Pixel Data holds ", h.pixel_bytes,
+                                declared, " bytes but the compressed Pixel Data holds ", h.layout.pixel_bytes,
                                 "; expected at most 1024 times its size (a wrong Rows, Columns or NumberOfFrames?)"));
         }
+    }
+    if (h.ts == gdcm::TransferSyntax::RLELossless && h.has_pixels) {
+        const unsigned segments = std::max(1u, h.samples_per_pixel) * ((h.bits_allocated + 7) / 8);
+        const auto frames = static_cast<std::uint64_t>(h.frames);
+        if (source.in_memory) check_rle(MemoryInput(source.bytes, source.label), h.layout, frames, h.rows, h.columns, segments);
+        else check_rle(InputFile(source.path, source.label), h.layout, frames, h.rows, h.columns, segments);
     }
     Geometry top;
     read_geometry(ds, top);
@@ -1068,7 +1093,7 @@ Volume build_volume(const std::vector<const Header*>& files, const std::vector<S
 std::vector<fs::path> dicomdir_files(const fs::path& dicomdir)
 {
     quiet_gdcm();
-    scan_dicom(InputFile(dicomdir, dicomdir.string()));
+    scan_dicom(InputFile(dicomdir, dicomdir.string()), dictionary_vr);
     gdcm::Reader reader;
     reader.SetFileName(dicomdir.c_str());
     bool ok = false;

@@ -132,7 +132,7 @@ enum class Until { end, item_delimiter };
 
 class Scanner {
 public:
-    explicit Scanner(const ByteInput& input) : input_(input), window_(input), size_(input.size()) {}
+    Scanner(const ByteInput& input, const DicomVrCheck& vr_check) : input_(input), window_(input), size_(input.size()), vr_check_(vr_check) {}
 
     DicomLayout run()
     {
@@ -334,6 +334,10 @@ private:
             if (e.group == 0xFEFF || e.is(0x00FF, 0x4AA5)) {
                 fail(Status::bad_format, e, "a byte-swapped item tag or a vendor marker GDCM reinterprets; expected a data element");
             }
+            if (e.vr && vr_check_) {
+                const std::string expected = vr_check_(e.group, e.element, e.vr->code);
+                if (!expected.empty()) fail(Status::bad_format, e, str_cat("VR ", e.vr->code, "; expected ", expected, " (PS3.6)"));
+            }
             const bool pixel_data = e.is(0x7FE0, 0x0010);
             if (pixel_data && s.explicit_vr && !(is_vr(e.vr, "OB") || is_vr(e.vr, "OW") || (is_vr(e.vr, "UN") && !e.undefined()))) {
                 fail(Status::bad_format, e, str_cat("Pixel Data with VR ", e.vr->code, "; expected OB or OW (PS3.5 8.2, A.4)"));
@@ -445,7 +449,10 @@ private:
                 fail(Status::bad_format, item,
                      str_cat("Basic Offset Table of ", item.length, " bytes; expected 32-bit offsets (a multiple of 4 bytes, PS3.5 A.4)"));
             }
-            if (index > 0) total += item.length;
+            if (index > 0) {
+                total += item.length;
+                if (top) layout_.fragments.emplace_back(item.value, item.length);
+            }
             at = item.value + item.length;
         }
     }
@@ -453,15 +460,73 @@ private:
     const ByteInput& input_;
     Window window_;
     std::uint64_t size_;
+    const DicomVrCheck& vr_check_;
     Syntax syntax_;
     DicomLayout layout_;
 };
 
 } // namespace
 
-DicomLayout scan_dicom(const ByteInput& input)
+DicomLayout scan_dicom(const ByteInput& input, const DicomVrCheck& vr_check)
 {
-    return Scanner(input).run();
+    return Scanner(input, vr_check).run();
+}
+
+void check_rle(const ByteInput& input, const DicomLayout& layout, std::uint64_t frames, std::uint64_t rows, std::uint64_t columns,
+               unsigned segments)
+{
+    const std::string& label = input.label();
+    if (layout.fragments.size() != frames) {
+        throw Error(Status::bad_format, str_cat(label, ": RLE Pixel Data with ", layout.fragments.size(), " fragments for ", frames,
+                                                " frame", frames == 1 ? "" : "s", "; expected one fragment per frame (PS3.5 G.2)"));
+    }
+    if (segments < 1 || segments > 15) {
+        throw Error(Status::bad_format, str_cat(label, ": RLE Pixel Data would need ", segments,
+                                                " segments per frame (samples x bytes per sample); expected 1 to 15 (PS3.5 G.2)"));
+    }
+    const std::uint64_t plane = rows * columns;
+    for (std::size_t f = 0; f < layout.fragments.size(); ++f) {
+        const auto [at, length] = layout.fragments[f];
+        const std::string frame = str_cat(label, ": RLE frame ", f + 1, " at byte ", at);
+        if (length < 64) throw Error(Status::bad_format, str_cat(frame, ": ", length, " bytes; expected the 64-byte RLE header first (PS3.5 G.5)"));
+        const std::string bytes = input.read_string(at, length);
+        const auto u32 = [&](std::size_t i) {
+            const auto* p = reinterpret_cast<const unsigned char*>(bytes.data()) + 4 * i;
+            return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
+        };
+        if (u32(0) != segments) {
+            throw Error(Status::bad_format, str_cat(frame, ": ", u32(0), " segments; expected ", segments,
+                                                    " (one per byte of each sample, PS3.5 G.2)"));
+        }
+        for (unsigned s = 0; s < segments; ++s) {
+            const std::uint64_t start = u32(1 + s), stop = s + 1 < segments ? u32(2 + s) : length;
+            if (start < 64 || start >= stop || stop > length || (s == 0 && start != 64)) {
+                throw Error(Status::bad_format, str_cat(frame, ": segment ", s + 1, " spans bytes ", start, " to ", stop, " of the ", length,
+                                                        "-byte fragment; expected increasing offsets after the 64-byte header (PS3.5 G.5)"));
+            }
+            // PackBits (PS3.5 G.3.1): n in 0..127 copies n+1 bytes, -127..-1 repeats the next byte 1-n times, -128 is a no-op
+            std::uint64_t out = 0, i = start;
+            while (out < plane && i < stop) {
+                const auto n = static_cast<signed char>(bytes[i++]);
+                std::uint64_t count = 0;
+                if (n >= 0) {
+                    count = static_cast<std::uint64_t>(n) + 1;
+                    if (stop - i < count) break;
+                    i += count;
+                } else if (n != -128) {
+                    count = static_cast<std::uint64_t>(1 - n);
+                    if (i == stop) break;
+                    ++i;
+                }
+                out += count;
+            }
+            if (out != plane) {
+                throw Error(Status::bad_format, str_cat(frame, ": segment ", s + 1, out < plane ? " ends after " : " runs past ",
+                                                        out < plane ? out : plane, " of its ", plane, " bytes (", columns, "x", rows,
+                                                        "); expected each segment to decode to one byte per pixel (PS3.5 G.3)"));
+            }
+        }
+    }
 }
 
 } // namespace cmc33::io::detail

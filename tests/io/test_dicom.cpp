@@ -383,8 +383,35 @@ TEST_F(DicomScan, SequencesNestedTooDeep)
 TEST_F(DicomScan, UndefinedLengthOnANonSequence)
 {
     DicomBytes d = image();
-    d.header(0x0008, 0x0081, "UT", 0xFFFFFFFFu).raw("abcd");
-    expect_error(d.bytes(), {"(0008,0081)", "undefined value length (FFFFFFFFH) on VR UT"});
+    d.header(0x0040, 0xa160, "UT", 0xFFFFFFFFu).raw("abcd");
+    expect_error(d.bytes(), {"(0040,a160)", "undefined value length (FFFFFFFFH) on VR UT"});
+}
+
+TEST_F(DicomScan, VrOtherThanTheDictionarys)
+{
+    // GDCM's typed accessors assert on such a VR (found by fuzzing)
+    expect_error(DicomBytes().header(0x0028, 0x0103, "SS", 2).u16(1).bytes(), {"(0028,0103)", "VR SS; expected US"});
+}
+
+TEST_F(DicomScan, MalformedRleIsRefusedBeforeDecoding)
+{
+    // GDCM's RLE decoder reads past its input on bad segment offsets (found by fuzzing)
+    const auto rle = [](std::uint32_t segments, std::uint32_t offset, const std::string& data) {
+        DicomBytes d("1.2.840.10008.1.2.5");
+        d.element(0x0008, 0x0060, "CS", "CT")
+            .header(0x0028, 0x0010, "US", 2).u16(2)
+            .header(0x0028, 0x0011, "US", 2).u16(2)
+            .header(0x0028, 0x0100, "US", 2).u16(8)
+            .header(0x7fe0, 0x0010, "OB", 0xFFFFFFFFu).item(0xE000, 0).item(0xE000, static_cast<std::uint32_t>(64 + data.size()));
+        d.u32(segments).u32(offset);
+        for (int i = 0; i < 14; ++i) d.u32(0);
+        return d.raw(data).item(0xE0DD, 0).bytes();
+    };
+    EXPECT_EQ(memory_error(rle(1, 64, "\x03" "abcd\0"s)).find("RLE"), std::string::npos); // one literal run of 4: 2x2 bytes
+    expect_error(rle(1, 200, "\x03" "abcd\0"s), {"RLE frame 1", "segment 1 spans bytes 200 to 70 of the 70-byte fragment"});
+    expect_error(rle(2, 64, "\x03" "abcd\0"s), {"RLE frame 1", "2 segments; expected 1"});
+    expect_error(rle(1, 64, "\x05" "abcdef\0"s), {"RLE frame 1", "segment 1 runs past 4 of its 4 bytes"});
+    expect_error(rle(1, 64, "\x01" "ab\0"s), {"RLE frame 1", "segment 1 ends after 2 of its 4 bytes"});
 }
 
 TEST_F(DicomScan, BadVrOddLengthAndStrayDelimiters)
