@@ -15,6 +15,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <iomanip>
 #include <limits>
 #include <map>
 #include <memory>
@@ -503,13 +504,24 @@ Header read_header(const Source& source, std::size_t index)
         h.has_pixels = tag == std::string("\xe0\x7f\x10\x00", 4) || tag == std::string("\x7f\xe0\x00\x10", 4);
         h.float_pixels = tag == std::string("\xe0\x7f\x08\x00", 4) || tag == std::string("\xe0\x7f\x09\x00", 4);
     }
-    h.rows = us_value(ds, kRows).value_or(0);
-    h.columns = us_value(ds, kColumns).value_or(0);
-    h.bits_allocated = us_value(ds, kBitsAllocated).value_or(0);
-    h.bits_stored = us_value(ds, kBitsStored).value_or(h.bits_allocated);
-    h.high_bit = us_value(ds, kHighBit).value_or(h.bits_stored > 0 ? h.bits_stored - 1 : 0);
-    h.representation = us_value(ds, kPixelRepresentation).value_or(0);
-    h.samples_per_pixel = us_value(ds, kSamplesPerPixel).value_or(1);
+    // A value of another size would be read here one way and by GDCM's decoder another (which
+    // asserts on a SamplesPerPixel it does not expect): refused.
+    const auto us = [&](const gdcm::Tag& tag, const char* name, unsigned missing) -> unsigned {
+        const std::string_view v = raw_value(ds, tag);
+        if (v.empty()) return missing;
+        if (v.size() != 2) {
+            throw Error(Status::bad_format, str_cat(source.label, ": ", name, " (", std::hex, std::setfill('0'), std::setw(4), tag.GetGroup(), ",",
+                                                    std::setw(4), tag.GetElement(), std::dec, ") holds ", v.size(), " bytes; expected one US value (2 bytes)"));
+        }
+        return *us_value(ds, tag);
+    };
+    h.rows = us(kRows, "Rows", 0);
+    h.columns = us(kColumns, "Columns", 0);
+    h.bits_allocated = us(kBitsAllocated, "BitsAllocated", 0);
+    h.bits_stored = us(kBitsStored, "BitsStored", h.bits_allocated);
+    h.high_bit = us(kHighBit, "HighBit", h.bits_stored > 0 ? h.bits_stored - 1 : 0);
+    h.representation = us(kPixelRepresentation, "PixelRepresentation", 0);
+    h.samples_per_pixel = us(kSamplesPerPixel, "SamplesPerPixel", 1);
     // Where the bytes after the header do not show the Pixel Data tag (a deflated data set), an
     // image's attributes say there is one; GDCM's decoder then reads it.
     if (!h.has_pixels && !h.float_pixels && h.rows > 0 && h.columns > 0 && h.bits_allocated > 0) h.has_pixels = true;
