@@ -1011,6 +1011,11 @@ Volume rescale(std::unique_ptr<std::byte[]> samples, const Grid& grid, const std
         lo = std::min({lo, a, b});
         hi = std::max({hi, a, b});
     }
+    if (!(lo >= -static_cast<double>(std::numeric_limits<float>::max()) && hi <= static_cast<double>(std::numeric_limits<float>::max()))) {
+        throw Error(Status::non_finite, str_cat(slices.front().name(), ": RescaleSlope and RescaleIntercept take the samples to ",
+                                                format_real(lo), " .. ", format_real(hi),
+                                                ", outside the float range; expected rescaled values a float holds"));
+    }
     ScalarType target = ScalarType::f32;
     if (whole && lo >= -32768 && hi <= 32767) target = ScalarType::i16;
     else if (whole && lo >= -2147483648.0 && hi <= 2147483647.0) target = ScalarType::i32;
@@ -1030,7 +1035,10 @@ Volume rescale(std::unique_ptr<std::byte[]> samples, const Grid& grid, const std
         for (std::size_t k = 0; k < slices.size(); ++k) {
             const double m = slices[k].geometry->slope, c = slices[k].geometry->intercept;
             const bool narrow = sizeof(T) <= 2 && std::fabs(m) <= 16384 && std::fabs(c) <= 536870912;
-            const auto mi = static_cast<std::int64_t>(m), ci = static_cast<std::int64_t>(c);
+            // used only for an integer target, whose slopes and intercepts are whole and small
+            // (`whole` above); a float target may have any, whose conversion would be undefined
+            const bool small = std::fabs(m) < 1e15 && std::fabs(c) < 1e15;
+            const auto mi = small ? static_cast<std::int64_t>(m) : 0, ci = small ? static_cast<std::int64_t>(c) : 0;
             for (std::size_t at = k * static_cast<std::size_t>(plane), stop = at + static_cast<std::size_t>(plane); at < stop;) {
                 const std::size_t n = std::min(kBlock, stop - at);
                 std::memcpy(block, src + at, n * sizeof(T));
