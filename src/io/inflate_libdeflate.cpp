@@ -8,6 +8,7 @@
 #if defined(CMC33_WITH_LIBDEFLATE) && CMC33_WITH_LIBDEFLATE
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -34,6 +35,17 @@ std::unique_ptr<std::byte[]> inflate_whole(std::string_view in, std::uint64_t sk
     // skip bytes are inflated and dropped: beyond the samples' size they would double the memory
     if (skip > out_size || out_size > std::numeric_limits<std::size_t>::max() - skip) return nullptr;
     const std::size_t total = static_cast<std::size_t>(skip) + out_size;
+    // Allocate the declared size only when the stream vouches for it: a gzip stream's last four
+    // bytes are its size mod 2^32 (ISIZE, RFC 1952), and deflate expands at most 1032:1. Otherwise
+    // InflateStream reads what the stream holds and says what is wrong, at the cost of those bytes.
+    const auto* head = reinterpret_cast<const unsigned char*>(in.data());
+    if (total / 1032 > in.size()) return nullptr;
+    if (is_gzip(head, in.size())) {
+        if (in.size() < 18) return nullptr;
+        const unsigned char* t = head + in.size() - 4;
+        const std::uint32_t isize = std::uint32_t{t[0]} | std::uint32_t{t[1]} << 8 | std::uint32_t{t[2]} << 16 | std::uint32_t{t[3]} << 24;
+        if (isize != static_cast<std::uint32_t>(total)) return nullptr;
+    }
     const std::unique_ptr<libdeflate_decompressor, DecompressorDeleter> decompressor(libdeflate_alloc_decompressor());
     if (!decompressor) return nullptr;
     // Pages are touched only as bytes are decoded, so a header that declares more than the stream

@@ -310,9 +310,9 @@ TEST(InflateWhole, GzipMembersSkipAndZeroPadding)
             SCOPED_TRACE("skip " + std::to_string(skip) + ", padding " + std::to_string(in.size() - packed.size()));
             const std::size_t size = a.size() + b.size() - skip;
 #if defined(CMC33_WITH_LIBDEFLATE) && CMC33_WITH_LIBDEFLATE
-            const auto whole = cmc33::io::detail::inflate_whole(in, skip, size);
-            ASSERT_TRUE(whole);
-            EXPECT_EQ(as_string(whole, size), (a + b).substr(skip));
+            // the last member's ISIZE is not the whole size: the stream does not vouch for the
+            // allocation, and the streaming inflater reads it
+            EXPECT_FALSE(cmc33::io::detail::inflate_whole(in, skip, size));
 #endif
             expect_same(run_inflate_exact(in, skip, size), run_streaming(in, skip, size));
         }
