@@ -185,6 +185,13 @@ private:
         return {static_cast<double>(p[0]) + 0.0, static_cast<double>(p[1]) + 0.0, static_cast<double>(p[2]) + 0.0};
     }
 
+    /// position() of a vertex that build() has already checked.
+    Point3 point(std::uint32_t v) const
+    {
+        const float* p = &m_.positions[static_cast<std::size_t>(3 * (static_cast<std::int64_t>(v) - m_.first_vertex))];
+        return {static_cast<double>(p[0]) + 0.0, static_cast<double>(p[1]) + 0.0, static_cast<double>(p[2]) + 0.0};
+    }
+
     Point3 index_of(const Point3& p) const
     {
         const double d[3] = {p[0] - m_.origin[0], p[1] - m_.origin[1], p[2] - m_.origin[2]};
@@ -254,8 +261,8 @@ private:
         if (!boxes_meet(a.box, b.box)) return;
         const std::uint32_t* a_ids = corners(a.triangle);
         const std::uint32_t* b_ids = corners(b.triangle);
-        const std::array<Point3, 3> a_points{position(a_ids[0]), position(a_ids[1]), position(a_ids[2])};
-        const std::array<Point3, 3> b_points{position(b_ids[0]), position(b_ids[1]), position(b_ids[2])};
+        const std::array<Point3, 3> a_points{point(a_ids[0]), point(a_ids[1]), point(a_ids[2])};
+        const std::array<Point3, 3> b_points{point(b_ids[0]), point(b_ids[1]), point(b_ids[2])};
         // corners of b that a has too (by id), and distinct ids at one position
         int match[3] = {-1, -1, -1};
         int shared = 0;

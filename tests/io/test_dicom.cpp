@@ -33,13 +33,7 @@ using namespace std::string_literals;
 /// The series write_dicom.py writes, once for the whole suite.
 const fs::path& series_dir()
 {
-    static const fs::path dir = [] {
-        const fs::path d = fs::temp_directory_path() / ("cmc33_test_dicom_" + std::to_string(::getpid()));
-        fs::remove_all(d);
-        const std::string command = std::string(CMC33_SYSTEM_PYTHON) + " " + CMC33_WRITE_DICOM + " " + d.string();
-        if (std::system(command.c_str()) != 0) return fs::path();
-        return d;
-    }();
+    static const fs::path dir = test::run_writer(CMC33_SYSTEM_PYTHON, CMC33_WRITE_DICOM, "cmc33_test_dicom_");
     return dir;
 }
 

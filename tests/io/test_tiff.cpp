@@ -37,13 +37,7 @@ std::vector<double> as_doubles(const Volume& volume)
 
 const fs::path& stacks_dir()
 {
-    static const fs::path dir = [] {
-        const fs::path d = fs::temp_directory_path() / ("cmc33_test_tiff_" + std::to_string(::getpid()));
-        fs::remove_all(d);
-        const std::string command = std::string(CMC33_SYSTEM_PYTHON) + " " + CMC33_WRITE_TIFF + " " + d.string();
-        if (std::system(command.c_str()) != 0) return fs::path();
-        return d;
-    }();
+    static const fs::path dir = test::run_writer(CMC33_SYSTEM_PYTHON, CMC33_WRITE_TIFF, "cmc33_test_tiff_");
     return dir;
 }
 

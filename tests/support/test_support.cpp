@@ -1,5 +1,7 @@
 #include "test_support.hpp"
 
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 #include <zlib.h>
 
@@ -35,6 +37,15 @@ std::string deflate_bytes(const std::string& data, int window_bits)
 
 std::string gzip_bytes(const std::string& data) { return deflate_bytes(data, 31); }
 std::string zlib_bytes(const std::string& data) { return deflate_bytes(data, 15); }
+
+std::filesystem::path run_writer(const std::string& python, const std::string& script, const std::string& name)
+{
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / (name + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    const std::string command = python + " " + script + " " + dir.string();
+    if (std::system(command.c_str()) != 0) return {};
+    return dir;
+}
 
 std::filesystem::path temp_dir()
 {

@@ -32,6 +32,10 @@ std::optional<std::filesystem::path> shared_volume(const std::string& file_name)
 /// Folder of the repository's small test files (tests/data).
 std::filesystem::path test_data_dir();
 
+/// Runs `python script FOLDER` (an independent writer: pydicom, tifffile, ...) into a fresh folder
+/// FOLDER = the temp directory / (`name` + this process's id); the folder, or empty if it failed.
+std::filesystem::path run_writer(const std::string& python, const std::string& script, const std::string& name);
+
 /// Writes bytes to a file (for building bad inputs).
 void write_file(const std::filesystem::path& path, const std::string& bytes);
 std::string read_file(const std::filesystem::path& path);
