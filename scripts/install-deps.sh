@@ -22,6 +22,10 @@ set -euo pipefail
 packages=(g++ cmake ninja-build pkg-config zlib1g-dev libdeflate-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev
           libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile python3-nibabel python3-vtk9)
+# node and npm run the Khronos glTF validator of tests/io/mesh_writers.py (tests/io/gltf); a node
+# from elsewhere, with its own npm, is kept.
+command -v node >/dev/null || packages+=(nodejs)
+command -v npm >/dev/null || packages+=(npm)
 for flag in "$@"; do
     case "$flag" in
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
