@@ -8,12 +8,14 @@
 // Writers stream a mesh that write_mesh() has already validated (sizes, indices < vertex count).
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <charconv>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -48,6 +50,41 @@ inline constexpr std::size_t kPlyFaceBytes = 13;         ///< uchar 3, uint a b 
 void write_obj(const Mesh& mesh, std::ostream& out, const double* offset = nullptr);
 void write_stl(const Mesh& mesh, std::ostream& out);
 void write_off(const Mesh& mesh, std::ostream& out, const double* offset = nullptr);
+
+// ---- glTF 2.0, VTK XML PolyData, GIfTI (written only; mesh_gltf.cpp, mesh_vtp.cpp, mesh_gifti.cpp) ----
+
+/// One mesh of a glTF scene: its own node and mesh, with a name and a base colour (linear RGBA)
+/// when given. One part now; the per-label meshes of a label map are one part each.
+struct GltfPart {
+    const Mesh* mesh = nullptr;
+    std::string name;                            ///< empty: none
+    std::optional<std::array<float, 4>> colour{}; ///< a material's baseColorFactor
+};
+/// A binary glTF (.glb): the JSON chunk, then one buffer in the BIN chunk.
+/// @throws Error{too_large} when the file would pass the 32-bit length of the GLB header.
+void write_glb(const std::vector<GltfPart>& parts, std::ostream& out, const MeshWriteOptions& options,
+               const std::string& name);
+/// The JSON of a .gltf whose buffer is the file `bin_uri` (relative to it; percent-encoded here).
+void write_gltf_json(const std::vector<GltfPart>& parts, std::ostream& out, const MeshWriteOptions& options,
+                     const std::string& bin_uri);
+/// The .bin of write_gltf_json.
+void write_gltf_bin(const std::vector<GltfPart>& parts, std::ostream& out);
+
+/// VTK XML PolyData, appended raw data compressed by blocks (vtkZLibDataCompressor).
+void write_vtp(const Mesh& mesh, std::ostream& out, const MeshWriteOptions& options, const std::string& name);
+/// GIfTI: a NIFTI_INTENT_POINTSET and a NIFTI_INTENT_TRIANGLE array (and NIFTI_INTENT_VECTOR
+/// normals), GZipBase64Binary. @throws Error{too_large} past 2^31 - 1 vertices (INT32 indices).
+void write_gifti(const Mesh& mesh, std::ostream& out, const MeshWriteOptions& options, const std::string& name);
+
+/// `size` bytes as one zlib stream (RFC 1950): deflated with zlib where the build has it, else in
+/// stored (uncompressed) deflate blocks, which every inflater reads.
+std::string zlib_compress(const void* data, std::size_t size, int level);
+/// Base64 (RFC 4648, with padding) of `size` bytes, appended to `out`.
+void append_base64(std::string& out, const void* data, std::size_t size);
+/// `text` with &, <, >, " and ' as XML character references.
+std::string xml_escape(std::string_view text);
+/// `text` as a JSON string literal (quotes included; control characters as \u00XX).
+std::string json_string(std::string_view text);
 
 
 class OutputBuffer;

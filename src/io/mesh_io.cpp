@@ -10,10 +10,16 @@
 #include <optional>
 #include <string>
 #include <system_error>
+#include <variant>
+#include <vector>
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
+#include <zlib.h>
+#endif
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
@@ -242,17 +248,132 @@ void write_position(OutputBuffer& o, const float* p, const double* offset)
     }
 }
 
+// ---- compression and text encodings of the glTF, VTP and GIfTI writers ------------------------
+
+std::string zlib_compress(const void* data, std::size_t size, int level)
+{
+#if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
+    uLongf bound = compressBound(static_cast<uLong>(size));
+    std::string out(static_cast<std::size_t>(bound), '\0');
+    const int status = compress2(reinterpret_cast<Bytef*>(out.data()), &bound, static_cast<const Bytef*>(data),
+                                 static_cast<uLong>(size), level);
+    if (status != Z_OK) {
+        throw Error(Status::too_large, concat("cannot compress ", size, " bytes (zlib status ", status, ")"));
+    }
+    out.resize(static_cast<std::size_t>(bound));
+    return out;
+#else
+    (void)level;
+    // RFC 1950: CMF 0x78 (deflate, 32 KiB window), FLG 0x01 (FCHECK: 0x7801 is a multiple of 31);
+    // RFC 1951 stored blocks (BTYPE 00) of at most 65535 bytes; the Adler-32 of the data, big-endian.
+    const auto* p = static_cast<const unsigned char*>(data);
+    std::string out;
+    out.reserve(size + 6 + 5 * (size / 65535 + 1));
+    out += static_cast<char>(0x78);
+    out += static_cast<char>(0x01);
+    std::size_t done = 0;
+    do {
+        const std::size_t n = std::min<std::size_t>(size - done, 65535);
+        out += static_cast<char>(done + n == size ? 1 : 0);
+        out += static_cast<char>(n & 0xff);
+        out += static_cast<char>(n >> 8);
+        out += static_cast<char>(~n & 0xff);
+        out += static_cast<char>((~n >> 8) & 0xff);
+        out.append(reinterpret_cast<const char*>(p + done), n);
+        done += n;
+    } while (done < size);
+    std::uint32_t a = 1, b = 0;
+    for (std::size_t i = 0; i < size; ++i) {
+        a = (a + p[i]) % 65521u;
+        b = (b + a) % 65521u;
+    }
+    const std::uint32_t adler = (b << 16) | a;
+    for (int shift = 24; shift >= 0; shift -= 8) out += static_cast<char>((adler >> shift) & 0xff);
+    return out;
+#endif
+}
+
+void append_base64(std::string& out, const void* data, std::size_t size)
+{
+    static constexpr char kAlphabet[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    const auto* p = static_cast<const unsigned char*>(data);
+    const std::size_t start = out.size();
+    out.resize(start + (size + 2) / 3 * 4);
+    char* o = out.data() + start;
+    std::size_t i = 0;
+    for (; i + 3 <= size; i += 3, o += 4) {
+        const std::uint32_t v = (std::uint32_t{p[i]} << 16) | (std::uint32_t{p[i + 1]} << 8) | p[i + 2];
+        o[0] = kAlphabet[v >> 18];
+        o[1] = kAlphabet[(v >> 12) & 63];
+        o[2] = kAlphabet[(v >> 6) & 63];
+        o[3] = kAlphabet[v & 63];
+    }
+    if (i < size) {
+        const bool two = i + 1 < size;
+        const std::uint32_t v = (std::uint32_t{p[i]} << 16) | (two ? std::uint32_t{p[i + 1]} << 8 : 0u);
+        o[0] = kAlphabet[v >> 18];
+        o[1] = kAlphabet[(v >> 12) & 63];
+        o[2] = two ? kAlphabet[(v >> 6) & 63] : '=';
+        o[3] = '=';
+    }
+}
+
+std::string xml_escape(std::string_view text)
+{
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        case '\'': out += "&apos;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+std::string json_string(std::string_view text)
+{
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out = "\"";
+    for (char c : text) {
+        const auto u = static_cast<unsigned char>(c);
+        if (c == '"' || c == '\\') {
+            out += '\\';
+            out += c;
+        } else if (u < 0x20) {
+            out += "\\u00";
+            out += kHex[u >> 4];
+            out += kHex[u & 15];
+        } else {
+            out += c;
+        }
+    }
+    out += '"';
+    return out;
+}
+
 // ---- dispatch -------------------------------------------------------------------------------
 
 namespace {
 
 constexpr const char* kAcceptedExtensions = ".ply, .obj, .stl or .off";
+/// What write_mesh() accepts: the readers' formats and the formats written only.
+constexpr const char* kWritableExtensions = ".ply, .obj, .stl, .off, .glb, .gltf, .vtp or .gii";
 
-[[noreturn]] void unsupported_extension(const std::string& name, const std::string& ext)
+[[noreturn]] void unsupported_extension(const std::string& name, const std::string& ext,
+                                        const char* expected = kAcceptedExtensions)
 {
     throw Error(Status::unsupported_format, concat(name, ": unsupported mesh extension ",
                                                    ext.empty() ? "(none)" : quote_text(ext),
-                                                   "; expected ", kAcceptedExtensions));
+                                                   "; expected ", expected));
+}
+
+bool written_only(const std::string& ext)
+{
+    return ext == ".glb" || ext == ".gltf" || ext == ".vtp" || ext == ".gii";
 }
 
 std::optional<MeshFormat> mesh_format(const std::string& ext)
@@ -376,6 +497,25 @@ void validate_for_writing(const Mesh& mesh, const std::string& name)
     }
 }
 
+void validate_arrays(const Mesh& mesh, const MeshWriteOptions& options, const std::string& name)
+{
+    auto check = [&](const std::vector<MeshArray>& arrays, std::size_t count, const char* per, const char* pers) {
+        for (const MeshArray& a : arrays) {
+            const std::size_t size = std::visit([](const auto& v) { return v.size(); }, a.values);
+            if (a.name.empty() || a.components < 1 ||
+                size != count * static_cast<std::size_t>(a.components)) {
+                throw Error(Status::invalid_argument,
+                            detail::concat(name, ": cannot write the array ", detail::quote_text(a.name), ": ", size,
+                                           " values of ", a.components, " components; expected a name and ",
+                                           a.components > 0 ? a.components : 1, " values per ", per, " (", count,
+                                           " ", pers, ")"));
+            }
+        }
+    };
+    check(options.vertex_arrays, mesh.vertex_count(), "vertex", "vertices");
+    check(options.triangle_arrays, mesh.triangle_count(), "triangle", "triangles");
+}
+
 } // namespace
 
 void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
@@ -383,8 +523,11 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
 {
     const std::string name = path.string();
     const std::string ext = detail::lower_extension(path);
-    if (!detail::mesh_format(ext)) detail::unsupported_extension(name, ext);
+    if (!detail::mesh_format(ext) && !detail::written_only(ext)) {
+        detail::unsupported_extension(name, ext, detail::kWritableExtensions);
+    }
     validate_for_writing(mesh, name);
+    validate_arrays(mesh, options, name);
     const double* offset = options.offset ? options.offset->data() : nullptr;
     if (offset && ext == ".stl") {
         throw Error(Status::invalid_argument,
@@ -397,8 +540,26 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
                                                       "triangles, not ",
                                                       mesh.triangle_count()));
     }
+    if (ext == ".gltf") {
+        // The buffer goes to STEM.bin beside the JSON (a relative uri), written first: a .gltf on
+        // disk always finds its whole buffer.
+        std::filesystem::path bin = path;
+        bin.replace_extension(".bin");
+        const std::vector<detail::GltfPart> parts{{&mesh, {}, {}}};
+        detail::write_atomically(bin, [&](std::ostream& out) { detail::write_gltf_bin(parts, out); });
+        detail::write_atomically(path, [&](std::ostream& out) {
+            detail::write_gltf_json(parts, out, options, bin.filename().string());
+        });
+        return;
+    }
     detail::write_atomically(path, [&](std::ostream& out) {
-        if (ext == ".ply") {
+        if (ext == ".glb") {
+            detail::write_glb({{&mesh, {}, {}}}, out, options, name);
+        } else if (ext == ".vtp") {
+            detail::write_vtp(mesh, out, options, name);
+        } else if (ext == ".gii") {
+            detail::write_gifti(mesh, out, options, name);
+        } else if (ext == ".ply") {
             detail::write_ply(mesh, out, options.ascii, offset);
         } else if (ext == ".obj") {
             detail::write_obj(mesh, out, offset);
@@ -432,6 +593,11 @@ Mesh read_mesh(const std::filesystem::path& path)
     const std::string name = path.string();
     const std::string ext = detail::lower_extension(path);
     const std::optional<MeshFormat> format = detail::mesh_format(ext);
+    if (!format && detail::written_only(ext)) {
+        throw Error(Status::unsupported_format,
+                    detail::concat(name, ": cmc33 writes ", detail::quote_text(ext),
+                                   " meshes but does not read them; expected ", detail::kAcceptedExtensions));
+    }
     if (!format) detail::unsupported_extension(name, ext);
     const FileImage file(path);
     return read_mesh_from_memory(file.bytes(), *format, name);

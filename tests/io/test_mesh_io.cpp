@@ -246,11 +246,11 @@ TEST(MeshIo, UnsupportedExtension)
 {
     const fs::path dir = cmc33::test::temp_dir();
     expect_error([&] { cmc33::io::write_mesh(test_cube(false), dir / "m.xyz"); },
-                 Status::unsupported_format, "\".xyz\"; expected .ply, .obj, .stl or .off");
+                 Status::unsupported_format, "\".xyz\"; expected .ply, .obj, .stl, .off, .glb, .gltf, .vtp or .gii");
     EXPECT_FALSE(fs::exists(dir / "m.xyz"));
     cmc33::test::write_file(dir / "m.gltf", "{}");
     expect_error([&] { cmc33::io::read_mesh(dir / "m.gltf"); }, Status::unsupported_format,
-                 "m.gltf");
+                 "m.gltf: cmc33 writes \".gltf\" meshes but does not read them; expected .ply, .obj, .stl or .off");
     expect_error([&] { cmc33::io::read_mesh(dir / "noext"); }, Status::unsupported_format,
                  "(none)");
 }

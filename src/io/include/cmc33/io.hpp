@@ -4,7 +4,8 @@
 ///
 /// Volumes: NRRD (.nrrd attached, .nhdr detached; raw or gzip), MetaImage (.mhd/.mha), VTK legacy
 /// STRUCTURED_POINTS (.vtk, binary or ASCII), and headerless raw (any other name, with RawOptions).
-/// Meshes: PLY (binary little-endian by default, or ASCII), OBJ, binary STL, OFF.
+/// Meshes: PLY (binary little-endian by default, or ASCII), OBJ, binary STL, OFF; written only:
+/// glTF 2.0 (.glb, .gltf), VTK XML PolyData (.vtp), GIfTI (.gii).
 ///
 /// Every reader checks every size it is told against what the file holds before allocating, and
 /// throws `Error` with a one-line message that names the file, what is wrong and what was expected.
@@ -16,8 +17,10 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <variant>
 #include <vector>
 
 #include "cmc33/mesh.hpp"
@@ -96,17 +99,34 @@ CMC33_IO_EXPORT void convert_space(Volume& volume, std::string_view space);
 /// .vtk (binary, big-endian), .raw (headerless, machine order). @throws Error.
 CMC33_IO_EXPORT void write_volume(const Volume& volume, const std::filesystem::path& path);
 
+/// A named array written beside a mesh, one tuple of `components` values per vertex or per
+/// triangle (VTK XML PolyData point or cell data). Not owned: the values must outlive the write.
+struct MeshArray {
+    std::string name;
+    std::variant<std::span<const float>, std::span<const std::int32_t>> values; ///< Float32 or Int32
+    int components = 1;
+};
+
 struct MeshWriteOptions {
     bool ascii = false; ///< PLY only: ASCII instead of binary little-endian
     /// Set: the mesh's positions are relative to this point, and are written in double precision
-    /// as offset + position (PLY `property double`, shortest round-trip text in OBJ and OFF; STL,
-    /// 32-bit floats only, refuses it). For meshes extracted with the volume's origin moved to 0,
-    /// far from which floats cannot keep them embedded (float_steps_per_cell()).
+    /// as offset + position (PLY `property double`, shortest round-trip text in OBJ and OFF, VTP
+    /// Float64 points, GIfTI NIFTI_TYPE_FLOAT64, a glTF node translation; STL, 32-bit floats only,
+    /// refuses it). For meshes extracted with the volume's origin moved to 0, far from which floats
+    /// cannot keep them embedded (float_steps_per_cell()).
     std::optional<Vec3> offset{};
+    /// The world space of the positions as Volume::space() names it ("left-posterior-superior",
+    /// "RAS", ...; empty: not known). glTF states it in `extras`; GIfTI writes RAS+ coordinates,
+    /// converting from another anatomical space (docs/formats.md).
+    std::string space{};
+    std::vector<MeshArray> vertex_arrays{};   ///< .vtp point data (e.g. the values at the vertices)
+    std::vector<MeshArray> triangle_arrays{}; ///< .vtp cell data (e.g. a label per triangle)
 };
 
-/// Writes .ply, .obj, .stl (binary) or .off. Normals are written where the format carries them
-/// (PLY, OBJ). @throws Error{unsupported_format} for another extension, Error{io_error}.
+/// Writes .ply, .obj, .stl (binary), .off, .glb, .gltf (+ a .bin of the same stem beside it),
+/// .vtp (VTK XML PolyData, zlib-compressed appended data) or .gii (GIfTI surface). Normals are
+/// written where the format carries them (PLY, OBJ, glTF, VTP, GIfTI).
+/// @throws Error{unsupported_format} for another extension, Error{io_error}.
 CMC33_IO_EXPORT void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
 
 /// Reads .ply (ASCII or binary, either endian), .obj, .stl (binary or ASCII) or .off. Polygons
