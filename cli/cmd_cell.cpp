@@ -231,7 +231,7 @@ void add_cell(CLI::App& app)
         ->type_name("NAME")
         ->check(method_validator());
     cmd->add_flag("--json", args->json, "Print one JSON object");
-    cmd->add_option("-o,--output", args->output, "Write the cell's mesh: .ply .obj .stl .off")
+    cmd->add_option("-o,--output", args->output, "Write the cell's mesh: .ply .obj .stl .off .glb .gltf .vtp .gii")
         ->type_name("OUT")
         ->check(non_empty("a mesh file name"));
     cmd->footer(

@@ -114,7 +114,7 @@ void run_extract(const ExtractArgs& args)
     }
     if (!args.output.empty()) {
         named_step(args.output, "writing the mesh",
-                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii, offset}); });
+                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii, offset, volume.space()}); });
     }
     if (offset) volume.set_origin(*offset);
 
@@ -150,13 +150,13 @@ void add_extract(CLI::App& app)
     cmd->add_option("-i,--iso", args->iso, "Isovalue (a sample equal to it counts as above)")
         ->required()
         ->check(number_check());
-    cmd->add_option("-o,--output", args->output, "Write the mesh: .ply .obj .stl .off (by extension)")
+    cmd->add_option("-o,--output", args->output, "Write the mesh: .ply .obj .stl .off .glb .gltf .vtp .gii (by extension)")
         ->type_name("OUT")
         ->check(non_empty("a mesh file name"));
     cmd->add_option("--method", args->method, "cmc33 (default), cmc33-paper, chernyaev, mc33-lewiner or mc")
         ->type_name("NAME")
         ->check(method_validator());
-    cmd->add_flag("--normals", args->normals, "Per-vertex normals from the field's gradient (.ply and .obj only)");
+    cmd->add_flag("--normals", args->normals, "Per-vertex normals from the field's gradient (not in .off or .stl)");
     cmd->add_option("--threads", args->threads, "Worker threads, 0 = all cores (default 0, at most 1024)")
         ->type_name("N")
         ->check(thread_count());
@@ -173,7 +173,7 @@ void add_extract(CLI::App& app)
         ->excludes(progress);
     cmd->add_option("--positions", args->positions,
                     "auto (default): 32-bit float positions, or double where floats cannot keep the mesh embedded "
-                    "far from the origin; float: always (refused where they cannot); double: always (.ply .obj .off)")
+                    "far from the origin; float: always (refused where they cannot); double: always (not .stl)")
         ->type_name("PRECISION")
         ->check(CLI::IsMember({"auto", "float", "double"}));
     cmd->add_option("--memory-limit", args->memory_limit,

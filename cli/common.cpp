@@ -502,10 +502,12 @@ void check_mesh_output(const std::string& output, bool ascii, bool normals, cons
     const fs::path path(output);
     std::string ext = path.extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    if (ext != ".ply" && ext != ".obj" && ext != ".stl" && ext != ".off") {
+    if (ext != ".ply" && ext != ".obj" && ext != ".stl" && ext != ".off" && ext != ".glb" && ext != ".gltf" &&
+        ext != ".vtp" && ext != ".gii") {
         // write_mesh checks the extension before it creates anything: let it say what it accepts.
         io::write_mesh(Mesh{}, path);
-        throw Error(Status::unsupported_format, output + ": unsupported mesh extension; expected .ply, .obj, .stl or .off");
+        throw Error(Status::unsupported_format,
+                    output + ": unsupported mesh extension; expected .ply, .obj, .stl, .off, .glb, .gltf, .vtp or .gii");
     }
     if (ascii && ext != ".ply") throw UsageError("--ascii is for .ply output only, not " + output);
     if (normals && (ext == ".off" || ext == ".stl")) {
