@@ -76,8 +76,8 @@ void write_vtp(const Mesh& mesh, std::ostream& out, const MeshWriteOptions& opti
 /// normals), GZipBase64Binary. @throws Error{too_large} past 2^31 - 1 vertices (INT32 indices).
 void write_gifti(const Mesh& mesh, std::ostream& out, const MeshWriteOptions& options, const std::string& name);
 
-/// `size` bytes as one zlib stream (RFC 1950): deflated with zlib where the build has it, else in
-/// stored (uncompressed) deflate blocks, which every inflater reads.
+/// `size` bytes as one zlib stream (RFC 1950): deflated with libdeflate or zlib where the build has
+/// them, else in stored (uncompressed) deflate blocks, which every inflater reads.
 std::string zlib_compress(const void* data, std::size_t size, int level);
 /// Base64 (RFC 4648, with padding) of `size` bytes, appended to `out`.
 void append_base64(std::string& out, const void* data, std::size_t size);
