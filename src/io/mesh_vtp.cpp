@@ -19,6 +19,7 @@
 #include <mutex>
 #include <ostream>
 #include <string>
+#include <system_error>
 #include <thread>
 #include <variant>
 #include <vector>
@@ -70,11 +71,16 @@ std::string compressed(const Array& a)
     };
     const std::size_t threads =
         std::min<std::size_t>(parts.size(), std::max(1u, std::thread::hardware_concurrency()));
-    {
-        std::vector<std::jthread> pool;
-        for (std::size_t k = 1; k < threads; ++k) pool.emplace_back(work);
-        work();
+    std::vector<std::thread> pool; // std::thread: the WebAssembly build's libc++ has no jthread
+    for (std::size_t k = 1; k < threads; ++k) {
+        try {
+            pool.emplace_back(work);
+        } catch (const std::system_error&) {
+            break; // no more threads: the ones there (and this one) take every block
+        }
     }
+    work();
+    for (std::thread& t : pool) t.join();
     if (failure) std::rethrow_exception(failure);
     std::string out((3 + blocks) * 8, '\0');
     store_le(out.data(), blocks);
