@@ -16,9 +16,7 @@
 namespace cmc33::detail {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon() / 2; // unit roundoff u = 2^-53
-
-thread_local PredicateStats g_stats;
+constexpr double kEps = kUnitRoundoff; // u = 2^-53
 
 int sign_of(double x) { return (x > 0) - (x < 0); }
 
@@ -117,24 +115,16 @@ int orient2d_rational(double ax, double ay, double bx, double by, double cx, dou
 
 } // namespace
 
-PredicateStats& predicate_stats() noexcept { return g_stats; }
+PredicateStats& predicate_stats() noexcept { return g_predicate_stats; }
 
-int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+int orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
 {
-    const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
-    const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
-    const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
-    const double m1 = bdy * cdz, m2 = bdz * cdy, m3 = cdy * adz, m4 = cdz * ady, m5 = ady * bdz, m6 = adz * bdy;
-    const double det = adx * (m1 - m2) + bdx * (m3 - m4) + cdx * (m5 - m6);
-    const double permanent = std::fabs(adx) * (std::fabs(m1) + std::fabs(m2)) +
-                             std::fabs(bdx) * (std::fabs(m3) + std::fabs(m4)) +
-                             std::fabs(cdx) * (std::fabs(m5) + std::fabs(m6));
-    // Each of the six terms carries at most 7 roundings relative to its size (three differences,
-    // two products, the inner difference, the sums): 8u of the permanent bounds the error.
-    const double bound = 8.5 * kEps * permanent;
-    if (det > bound || -det > bound) {
-        ++g_stats.filtered;
-        return sign_of(det);
+    // four points with one coordinate equal (a flat of a grid-aligned surface): a zero column
+    for (std::size_t k = 0; k < 3; ++k) {
+        if (a[k] == d[k] && b[k] == d[k] && c[k] == d[k]) {
+            ++g_predicate_stats.expansion;
+            return 0;
+        }
     }
     double da[3], db[3], dc[3];
     if (exact_differences(a.data(), d.data(), da, 3) && exact_differences(b.data(), d.data(), db, 3) &&
@@ -148,32 +138,27 @@ int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
         triple_product(-dc[0], da[2], db[1], terms + 20);
         const int s = sign_of_sum(terms, 24);
         if (s != 2) {
-            ++g_stats.expansion;
+            ++g_predicate_stats.expansion;
             return s;
         }
     }
-    ++g_stats.rational;
+    ++g_predicate_stats.rational;
     return orient3d_rational(a, b, c, d);
 }
 
-int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop)
+int orient2d_exact(const Point3& a, const Point3& b, const Point3& c, int drop)
 {
     const auto u = static_cast<std::size_t>(drop == 0 ? 1 : 0), v = static_cast<std::size_t>(drop == 2 ? 1 : 2);
     const double acx = a[u] - c[u], acy = a[v] - c[v], bcx = b[u] - c[u], bcy = b[v] - c[v];
     const double l = acx * bcy, r = acy * bcx;
     const double det = l - r;
-    const double bound = 4.5 * kEps * (std::fabs(l) + std::fabs(r));
-    if (det > bound || -det > bound) {
-        ++g_stats.filtered;
-        return sign_of(det);
-    }
     const double pa[2] = {a[u], a[v]}, pb[2] = {b[u], b[v]}, pc[2] = {c[u], c[v]};
     double dac[2], dbc[2];
     if (exact_differences(pa, pc, dac, 2) && exact_differences(pb, pc, dbc, 2)) {
         // both products exact (collinear points of a grid-aligned mesh, typically): l - r has
         // the sign of the exact determinant, rounding or not
         if (std::fma(acx, bcy, -l) == 0 && std::fma(acy, bcx, -r) == 0) {
-            ++g_stats.expansion;
+            ++g_predicate_stats.expansion;
             return sign_of(det);
         }
         double terms[4];
@@ -183,11 +168,11 @@ int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop)
         terms[3] = -std::fma(dac[1], dbc[0], terms[2]);
         const int s = sign_of_sum(terms, 4);
         if (s != 2) {
-            ++g_stats.expansion;
+            ++g_predicate_stats.expansion;
             return s;
         }
     }
-    ++g_stats.rational;
+    ++g_predicate_stats.rational;
     return orient2d_rational(a[u], a[v], b[u], b[v], c[u], c[v]);
 }
 
@@ -306,9 +291,20 @@ bool split_by_line(const Point3& p, const Point3& q, const Point3& x, const Poin
 
 bool triangles_meet_improperly(const std::array<Point3, 3>& t, const std::array<Point3, 3>& u, int shared)
 {
-    // The usual cases first, decided by filtered 2D orientations, which settle coplanar neighbours
-    // (flat parts of a surface) without exact arithmetic: a line through the shared corners that
-    // has the rest of t strictly on one side and the rest of u strictly on the other.
+    // The usual case of a curved surface first, by the filters alone: the rest of one triangle
+    // strictly on one side of the other's plane, which then holds only what they share.
+    if (shared == 2 && orient3d_filter(t[0], t[1], t[2], u[2]) != 0) return false;
+    if (shared == 1) {
+        for (int pass = 0; pass < 2; ++pass) {
+            const auto& x = pass == 0 ? t : u;
+            const auto& y = pass == 0 ? u : t;
+            const int s = orient3d_filter(x[0], x[1], x[2], y[1]);
+            if (s != 0 && orient3d_filter(x[0], x[1], x[2], y[2]) == s) return false;
+        }
+    }
+    // Then filtered 2D orientations, which settle coplanar neighbours (flat parts of a surface)
+    // without exact arithmetic: a line through the shared corners that has the rest of t strictly
+    // on one side and the rest of u strictly on the other.
     if (shared == 2 && split_by_line(t[0], t[1], t[2], u[2], u[2], dominant_axis(t))) return false;
     if (shared == 1) {
         const int drop = dominant_axis(t);

@@ -17,18 +17,78 @@
 // assume non-degenerate triangles (non-collinear corners): callers check degeneracy first.
 
 #include <array>
+#include <cmath>
+#include <cstddef>
 #include <cstdint>
 
 namespace cmc33::detail {
 
 using Point3 = std::array<double, 3>;
 
+/// Counts of the predicate paths taken (for tests and profiling; per thread, not synchronised).
+struct PredicateStats {
+    std::int64_t filtered = 0; ///< decided by the floating-point filter
+    std::int64_t expansion = 0; ///< decided by error-free transformations
+    std::int64_t rational = 0; ///< decided by GMP
+};
+PredicateStats& predicate_stats() noexcept;
+
+/// This thread's counts (inline so that the filters, inline below, count without a call).
+inline thread_local PredicateStats g_predicate_stats;
+
+inline constexpr double kUnitRoundoff = 0x1p-53;
+
+/// orient3d's sign when the floating-point filter decides it, else 0 (undecided, not "coplanar").
+inline int orient3d_filter(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+{
+    const double adx = a[0] - d[0], ady = a[1] - d[1], adz = a[2] - d[2];
+    const double bdx = b[0] - d[0], bdy = b[1] - d[1], bdz = b[2] - d[2];
+    const double cdx = c[0] - d[0], cdy = c[1] - d[1], cdz = c[2] - d[2];
+    const double m1 = bdy * cdz, m2 = bdz * cdy, m3 = cdy * adz, m4 = cdz * ady, m5 = ady * bdz, m6 = adz * bdy;
+    const double det = adx * (m1 - m2) + bdx * (m3 - m4) + cdx * (m5 - m6);
+    const double permanent = std::fabs(adx) * (std::fabs(m1) + std::fabs(m2)) + std::fabs(bdx) * (std::fabs(m3) + std::fabs(m4)) +
+                             std::fabs(cdx) * (std::fabs(m5) + std::fabs(m6));
+    // Each of the six terms carries at most 7 roundings relative to its size (three differences,
+    // two products, the inner difference, the sums): 8u of the permanent bounds the error.
+    const double bound = 8.5 * kUnitRoundoff * permanent;
+    return (det > bound) - (-det > bound);
+}
+
+/// orient2d's sign (below) when the floating-point filter decides it, else 0.
+inline int orient2d_filter(const Point3& a, const Point3& b, const Point3& c, int drop)
+{
+    const auto u = static_cast<std::size_t>(drop == 0 ? 1 : 0), v = static_cast<std::size_t>(drop == 2 ? 1 : 2);
+    const double l = (a[u] - c[u]) * (b[v] - c[v]), r = (a[v] - c[v]) * (b[u] - c[u]);
+    const double det = l - r;
+    const double bound = 4.5 * kUnitRoundoff * (std::fabs(l) + std::fabs(r));
+    return (det > bound) - (-det > bound);
+}
+
+/// orient3d past its filter: error-free transformations, then rationals.
+int orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+/// orient2d past its filter.
+int orient2d_exact(const Point3& a, const Point3& b, const Point3& c, int drop);
+
 /// Sign of det[a - d, b - d, c - d]: +1 when d lies below the plane of (a, b, c) as seen with
 /// (a, b, c) counter-clockwise, i.e. on the side its right-handed normal does not point to.
-int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
+inline int orient3d(const Point3& a, const Point3& b, const Point3& c, const Point3& d)
+{
+    if (const int s = orient3d_filter(a, b, c, d)) {
+        ++g_predicate_stats.filtered;
+        return s;
+    }
+    return orient3d_exact(a, b, c, d);
+}
 
 /// Sign of det[a - c, b - c] of the points projected on the plane that drops coordinate `drop`.
-int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop);
+inline int orient2d(const Point3& a, const Point3& b, const Point3& c, int drop)
+{
+    if (const int s = orient2d_filter(a, b, c, drop)) {
+        ++g_predicate_stats.filtered;
+        return s;
+    }
+    return orient2d_exact(a, b, c, drop);
+}
 
 /// True iff a, b, c are collinear (the triangle has zero area), exactly.
 bool collinear(const Point3& a, const Point3& b, const Point3& c);
@@ -44,13 +104,5 @@ bool segment_meets_triangle(const Point3& p, const Point3& q, const Point3& a, c
 /// corners are equal points, listed first: for one shared corner t[0] == u[0]; for two, t[0] ==
 /// u[0] and t[1] == u[1]). True iff they meet anywhere other than in what they share.
 bool triangles_meet_improperly(const std::array<Point3, 3>& t, const std::array<Point3, 3>& u, int shared);
-
-/// Counts of the predicate paths taken (for tests and profiling; per thread, not synchronised).
-struct PredicateStats {
-    std::int64_t filtered = 0; ///< decided by the floating-point filter
-    std::int64_t expansion = 0; ///< decided by error-free transformations
-    std::int64_t rational = 0; ///< decided by GMP
-};
-PredicateStats& predicate_stats() noexcept;
 
 } // namespace cmc33::detail
