@@ -5,6 +5,7 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
+#include "cmc33/mesh_ops.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/version.hpp"
 #include "cmc33/volume.hpp"

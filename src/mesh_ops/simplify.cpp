@@ -1,0 +1,359 @@
+// simplify(): quadric-ordered edge collapses that keep topology, manifoldness and embedding.
+//
+// Quadrics: Garland and Heckbert 1997, "Surface Simplification Using Quadric Error Metrics": each
+// input triangle's plane adds its squared-distance form to its three corners; a boundary edge adds
+// the plane through it perpendicular to its triangle, so boundaries keep their shape. A collapse
+// of edge ab puts the kept vertex at the minimum of Qa + Qb on the segment ab (clamped to it):
+// the unconstrained 3D optimum is ill-conditioned on the flat and cylindrical patches a marching
+// cubes mesh is made of and can land far from both stars, where the embedding check refuses it;
+// on the segment the vertex stays within the two stars' region and the cost is still minimal there.
+//
+// Topology: the link condition (Dey, Edelsbrunner, Guha and Nekhayev 1999) with the boundary coned
+// off by a virtual vertex: for interior edge ab with opposite corners c and d, the common
+// neighbours of a and b must be exactly {c, d}, and triangles acd and bcd must not both exist (a
+// tetrahedron, the smallest closed component); an interior edge between two boundary vertices is
+// refused (it would pinch); a boundary edge's endpoints must have only its opposite corner c in
+// common, and a boundary loop of three edges is kept. An interior vertex collapsing onto a
+// boundary vertex goes to the boundary vertex's position.
+
+#include <algorithm>
+#include <cmath>
+#include <queue>
+#include <string>
+
+#include "cmc33/error.hpp"
+#include "cmc33/mesh_ops.hpp"
+#include "work_mesh.hpp"
+
+namespace cmc33 {
+
+namespace {
+
+using mesh_ops::Pos;
+using mesh_ops::Refusal;
+using mesh_ops::Tri;
+using mesh_ops::WorkMesh;
+
+/// Symmetric 4x4 form: a00 a01 a02 a03 a11 a12 a13 a22 a23 a33.
+struct Quadric {
+    std::array<double, 10> q{};
+    void add_plane(double nx, double ny, double nz, double d, double w)
+    {
+        q[0] += w * nx * nx; q[1] += w * nx * ny; q[2] += w * nx * nz; q[3] += w * nx * d;
+        q[4] += w * ny * ny; q[5] += w * ny * nz; q[6] += w * ny * d;
+        q[7] += w * nz * nz; q[8] += w * nz * d;
+        q[9] += w * d * d;
+    }
+    Quadric& operator+=(const Quadric& o)
+    {
+        for (std::size_t i = 0; i < 10; ++i) q[i] += o.q[i];
+        return *this;
+    }
+    double eval(double x, double y, double z) const
+    {
+        return q[0] * x * x + 2 * q[1] * x * y + 2 * q[2] * x * z + 2 * q[3] * x + q[4] * y * y + 2 * q[5] * y * z +
+               2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
+    }
+};
+
+struct Candidate {
+    double cost;
+    std::uint32_t a, b;   ///< a < b
+    std::uint32_t va, vb; ///< versions of a and b when computed
+    Pos p;
+    bool operator<(const Candidate& o) const // for a min-heap: "greater" means popped later
+    {
+        if (cost != o.cost) return cost > o.cost;
+        if (a != o.a) return a > o.a;
+        return b > o.b;
+    }
+};
+
+struct Simplifier {
+    WorkMesh m;
+    std::vector<Quadric> quadric;
+    std::vector<std::uint32_t> version;
+    std::priority_queue<Candidate> heap;
+    SimplifyStats stats;
+
+    explicit Simplifier(const Mesh& mesh) : m(mesh), quadric(m.pos.size()), version(m.pos.size(), 0)
+    {
+        for (std::size_t t = 0; t < m.tri.size(); ++t) {
+            const Tri& c = m.tri[t];
+            const Pos& a = m.pos[c[0]];
+            const Pos& b = m.pos[c[1]];
+            const Pos& d = m.pos[c[2]];
+            double n[3], e1[3], e2[3];
+            for (int k = 0; k < 3; ++k) {
+                e1[k] = static_cast<double>(b[k]) - static_cast<double>(a[k]);
+                e2[k] = static_cast<double>(d[k]) - static_cast<double>(a[k]);
+            }
+            n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+            n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+            n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+            const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+            if (!(len > 0)) continue;
+            for (double& x : n) x /= len;
+            const double off = -(n[0] * static_cast<double>(a[0]) + n[1] * static_cast<double>(a[1]) + n[2] * static_cast<double>(a[2]));
+            for (const std::uint32_t v : c) quadric[v].add_plane(n[0], n[1], n[2], off, 1);
+            // boundary edges: a plane through the edge, perpendicular to the triangle
+            for (int i = 0; i < 3; ++i) {
+                const std::uint32_t u = c[static_cast<std::size_t>(i)];
+                const std::uint32_t w = c[static_cast<std::size_t>((i + 1) % 3)];
+                if (!m.boundary[u] || !m.boundary[w] || edge_triangles(u, w) != 1) continue;
+                double e[3], q[3];
+                for (int k = 0; k < 3; ++k) e[k] = static_cast<double>(m.pos[w][k]) - static_cast<double>(m.pos[u][k]);
+                q[0] = e[1] * n[2] - e[2] * n[1];
+                q[1] = e[2] * n[0] - e[0] * n[2];
+                q[2] = e[0] * n[1] - e[1] * n[0];
+                const double ql = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+                if (!(ql > 0)) continue;
+                for (double& x : q) x /= ql;
+                const double qo = -(q[0] * static_cast<double>(m.pos[u][0]) + q[1] * static_cast<double>(m.pos[u][1]) +
+                                    q[2] * static_cast<double>(m.pos[u][2]));
+                quadric[u].add_plane(q[0], q[1], q[2], qo, 1);
+                quadric[w].add_plane(q[0], q[1], q[2], qo, 1);
+            }
+        }
+    }
+
+    int edge_triangles(std::uint32_t u, std::uint32_t w) const
+    {
+        int n = 0;
+        for (const std::uint32_t t : m.vtris[u]) {
+            const Tri& c = m.tri[t];
+            if (c[0] == w || c[1] == w || c[2] == w) ++n;
+        }
+        return n;
+    }
+
+    /// Cost and position of collapsing edge ab.
+    Candidate evaluate(std::uint32_t a, std::uint32_t b) const
+    {
+        Candidate c{0, std::min(a, b), std::max(a, b), 0, 0, {}};
+        c.va = version[c.a];
+        c.vb = version[c.b];
+        Quadric q = quadric[a];
+        q += quadric[b];
+        if (m.boundary[a] != m.boundary[b]) {
+            c.p = m.boundary[a] ? m.pos[a] : m.pos[b];
+        } else {
+            const Pos& pa = m.pos[c.a];
+            const Pos& pb = m.pos[c.b];
+            double x[3], e[3];
+            for (int k = 0; k < 3; ++k) {
+                x[k] = static_cast<double>(pa[k]);
+                e[k] = static_cast<double>(pb[k]) - x[k];
+            }
+            // Q(x + t e) = Q(x) + 2 t (e.A x + e.b) + t^2 e.A e
+            const auto& s = q.q;
+            const double ax[3] = {s[0] * x[0] + s[1] * x[1] + s[2] * x[2] + s[3], s[1] * x[0] + s[4] * x[1] + s[5] * x[2] + s[6],
+                                  s[2] * x[0] + s[5] * x[1] + s[7] * x[2] + s[8]};
+            const double ae[3] = {s[0] * e[0] + s[1] * e[1] + s[2] * e[2], s[1] * e[0] + s[4] * e[1] + s[5] * e[2],
+                                  s[2] * e[0] + s[5] * e[1] + s[7] * e[2]};
+            const double lin = e[0] * ax[0] + e[1] * ax[1] + e[2] * ax[2];
+            const double quad = e[0] * ae[0] + e[1] * ae[1] + e[2] * ae[2];
+            // flat along the edge (every t costs the same): the midpoint keeps triangles even
+            double t = 0.5;
+            if (quad > 1e-12 * (std::abs(lin) + 1e-300)) t = std::clamp(-lin / quad, 0.0, 1.0);
+            for (int k = 0; k < 3; ++k) c.p[static_cast<std::size_t>(k)] = static_cast<float>(x[k] + t * e[k]);
+        }
+        c.cost = std::max(0.0, q.eval(static_cast<double>(c.p[0]), static_cast<double>(c.p[1]), static_cast<double>(c.p[2])));
+        return c;
+    }
+
+    void push_edges_of(std::uint32_t v)
+    {
+        std::uint32_t seen[64];
+        int n = 0;
+        for (const std::uint32_t t : m.vtris[v]) {
+            for (const std::uint32_t w : m.tri[t]) {
+                if (w == v || std::find(seen, seen + n, w) != seen + n) continue;
+                if (n < 64) seen[n++] = w;
+                heap.push(evaluate(v, w));
+            }
+        }
+    }
+
+    void seed()
+    {
+        for (std::uint32_t v = 0; v < m.pos.size(); ++v) {
+            for (const std::uint32_t t : m.vtris[v]) {
+                for (const std::uint32_t w : m.tri[t]) {
+                    // each edge once, from its triangle where it runs from the smaller index
+                    if (w > v) {
+                        const Tri& c = m.tri[t];
+                        int i = 0;
+                        while (c[static_cast<std::size_t>(i)] != v) ++i;
+                        if (c[static_cast<std::size_t>((i + 1) % 3)] == w || edge_triangles(v, w) == 1) {
+                            heap.push(evaluate(v, w));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The neighbours of v (sorted).
+    void neighbours(std::uint32_t v, std::vector<std::uint32_t>& out) const
+    {
+        out.clear();
+        for (const std::uint32_t t : m.vtris[v])
+            for (const std::uint32_t w : m.tri[t])
+                if (w != v) out.push_back(w);
+        std::sort(out.begin(), out.end());
+        out.erase(std::unique(out.begin(), out.end()), out.end());
+    }
+
+    bool has_triangle(std::uint32_t a, std::uint32_t b, std::uint32_t c) const
+    {
+        for (const std::uint32_t t : m.vtris[a]) {
+            const Tri& x = m.tri[t];
+            const bool hb = x[0] == b || x[1] == b || x[2] == b;
+            const bool hc = x[0] == c || x[1] == c || x[2] == c;
+            if (hb && hc) return true;
+        }
+        return false;
+    }
+
+    std::vector<std::uint32_t> na_, nb_, common_, shared_, changed_;
+    std::vector<Tri> new_tris_;
+
+    /// Link condition and boundary rules for collapsing b into a.
+    bool topology_ok(std::uint32_t a, std::uint32_t b)
+    {
+        if (m.locked[a] || m.locked[b]) return false;
+        shared_.clear();
+        for (const std::uint32_t t : m.vtris[a]) {
+            const Tri& c = m.tri[t];
+            if (c[0] == b || c[1] == b || c[2] == b) shared_.push_back(t);
+        }
+        if (shared_.empty() || shared_.size() > 2) return false;
+        std::uint32_t opp[2] = {0, 0};
+        for (std::size_t i = 0; i < shared_.size(); ++i)
+            for (const std::uint32_t w : m.tri[shared_[i]])
+                if (w != a && w != b) opp[i] = w;
+        neighbours(a, na_);
+        neighbours(b, nb_);
+        common_.clear();
+        std::set_intersection(na_.begin(), na_.end(), nb_.begin(), nb_.end(), std::back_inserter(common_));
+        if (shared_.size() == 2) {
+            if (m.boundary[a] && m.boundary[b]) return false;
+            if (common_.size() != 2) return false;
+            if (has_triangle(a, opp[0], opp[1]) && has_triangle(b, opp[0], opp[1])) return false;
+            return true;
+        }
+        // boundary edge
+        if (common_.size() != 1) return false;
+        const std::uint32_t c = opp[0];
+        if (edge_triangles(a, c) == 1 && edge_triangles(b, c) == 1) return false; // a loop of three
+        return true;
+    }
+
+    /// Tries the collapse: b merges into a, a moves to p. False (and nothing changed) if refused.
+    bool try_collapse(std::uint32_t a, std::uint32_t b, const Pos& p)
+    {
+        if (!topology_ok(a, b)) {
+            ++stats.refused_topology;
+            return false;
+        }
+        changed_.clear();
+        new_tris_.clear();
+        for (const std::uint32_t v : {a, b}) {
+            for (const std::uint32_t t : m.vtris[v]) {
+                if (std::find(shared_.begin(), shared_.end(), t) != shared_.end()) continue;
+                if (v == a && std::find(changed_.begin(), changed_.end(), t) != changed_.end()) continue;
+                Tri c = m.tri[t];
+                for (auto& w : c)
+                    if (w == b) w = a;
+                changed_.push_back(t);
+                new_tris_.push_back(c);
+            }
+        }
+        const Refusal r = m.check(changed_, new_tris_, a, p, shared_);
+        if (r == Refusal::flip) ++stats.refused_flip;
+        if (r == Refusal::intersection) ++stats.refused_intersection;
+        if (r != Refusal::none) return false;
+        // apply
+        for (const std::uint32_t t : shared_) {
+            m.grid.remove(t);
+            m.alive[t] = 0;
+            --m.alive_count;
+            for (const std::uint32_t w : m.tri[t]) {
+                auto& list = m.vtris[w];
+                list.erase(std::find(list.begin(), list.end(), t));
+            }
+        }
+        for (std::size_t i = 0; i < changed_.size(); ++i) m.grid.remove(changed_[i]);
+        for (const std::uint32_t t : m.vtris[b]) m.vtris[a].push_back(t);
+        m.vtris[b].clear();
+        m.vtris[b].shrink_to_fit();
+        m.pos[a] = p;
+        for (std::size_t i = 0; i < changed_.size(); ++i) {
+            m.tri[changed_[i]] = new_tris_[i];
+            m.grid.insert(changed_[i], m.corners(changed_[i]));
+        }
+        quadric[a] += quadric[b];
+        ++version[a];
+        ++version[b];
+        ++stats.collapses;
+        return true;
+    }
+};
+
+} // namespace
+
+Mesh simplify(const Mesh& mesh, const SimplifyOptions& options, SimplifyStats* stats_out)
+{
+    if (!(options.ratio > 0 && options.ratio <= 1)) {
+        throw Error(Status::invalid_argument, "simplify: ratio must be in (0, 1], got " + std::to_string(options.ratio));
+    }
+    if (options.target_triangles < 0) throw Error(Status::invalid_argument, "simplify: target triangles must be >= 0");
+    if (std::isnan(options.max_error) || options.max_error < 0) {
+        throw Error(Status::invalid_argument, "simplify: max error must be >= 0");
+    }
+    Simplifier s(mesh);
+    const std::int64_t start = s.m.alive_count;
+    // no count target (ratio 1): the error bound alone stops it; with neither, nothing is done
+    std::int64_t target = options.target_triangles > 0 ? options.target_triangles
+                          : options.ratio < 1          ? static_cast<std::int64_t>(std::ceil(options.ratio * static_cast<double>(start)))
+                          : std::isinf(options.max_error) ? start
+                                                          : 0;
+    const double max_cost = std::isinf(options.max_error) ? options.max_error : options.max_error * options.max_error;
+    std::int64_t since_progress = 0;
+    // When the queue runs dry, every edge is tried again: refusals are local, and the
+    // neighbourhood of a refused edge may have changed since (at most a few rounds).
+    for (int round = 0; round < 4 && s.m.alive_count > target; ++round) {
+        const std::int64_t before = s.stats.collapses;
+        s.seed();
+        while (!s.heap.empty() && s.m.alive_count > target) {
+            const Candidate c = s.heap.top();
+            s.heap.pop();
+            if (c.va != s.version[c.a] || c.vb != s.version[c.b]) continue; // stale
+            if (s.m.vtris[c.a].empty() || s.m.vtris[c.b].empty()) continue;
+            if (c.cost > max_cost) {
+                target = s.m.alive_count; // the error bound stops it
+                break;
+            }
+            // keep the boundary vertex when one is on the boundary (the candidate's position is its)
+            std::uint32_t keep = c.a, gone = c.b;
+            if (s.m.boundary[c.b] && !s.m.boundary[c.a]) std::swap(keep, gone);
+            if (s.try_collapse(keep, gone, c.p)) {
+                s.stats.max_quadric_error = std::max(s.stats.max_quadric_error, std::sqrt(c.cost));
+                s.push_edges_of(keep);
+                s.m.maybe_rebuild_grid();
+            }
+            if (options.progress && ++since_progress >= 4096) {
+                since_progress = 0;
+                const double f = static_cast<double>(start - s.m.alive_count) / static_cast<double>(std::max<std::int64_t>(1, start - target));
+                if (!options.progress(std::min(1.0, f))) throw Error(Status::cancelled, "simplify: cancelled");
+            }
+        }
+        s.heap = {};
+        if (s.stats.collapses == before) break;
+    }
+    if (stats_out) *stats_out = s.stats;
+    return s.m.to_mesh(mesh.has_normals());
+}
+
+} // namespace cmc33
