@@ -514,6 +514,14 @@ void check_mesh_output(const std::string& output, bool ascii, bool normals, cons
         throw UsageError(output + ": OFF/STL cannot store normals; use .ply or .obj, or drop --normals");
     }
     check_not_an_input(output, inputs);
+    // A .gltf writes its buffer to STEM.bin beside it: that file must not be an input either.
+    if (ext == ".gltf") {
+        try {
+            check_not_an_input(fs::path(path).replace_extension(".bin").string(), inputs);
+        } catch (const UsageError& e) {
+            throw UsageError(output + " writes its buffer beside it: " + e.what());
+        }
+    }
     // A directory, a device, a read-only file: refused now, as the writer would refuse them.
     const fs::path target = io::detail::output_target(path).target;
     const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
