@@ -8,7 +8,9 @@
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <algorithm>
 #include <array>
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -167,6 +169,50 @@ Volume volume_from_array(const py::array& array, const Vec3& spacing, const Vec3
     v.set_direction(direction);
     if (v.byte_size() > 0) std::memcpy(v.bytes(), s.data, v.byte_size());
     return v;
+}
+
+/// "RAS", "LPS", ... for a space named by letters or by words ("left-posterior-superior"); "" for
+/// none or a space that is not anatomical (one letter per world axis: R/L, A/P, S/I).
+std::string space_code(const std::string& name)
+{
+    std::string words = name, code;
+    for (char& c : words) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (words.size() == 3) {
+        for (char c : words) code += static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    } else {
+        std::size_t at = 0;
+        while (at <= words.size() && !words.empty()) {
+            const std::size_t dash = std::min(words.find('-', at), words.size());
+            const std::string word = words.substr(at, dash - at);
+            static const std::array<std::pair<const char*, char>, 6> kWords{{{"right", 'R'}, {"left", 'L'}, {"anterior", 'A'},
+                                                                              {"posterior", 'P'}, {"superior", 'S'}, {"inferior", 'I'}}};
+            const auto* hit = std::find_if(kWords.begin(), kWords.end(), [&](const auto& w) { return word == w.first; });
+            if (hit == kWords.end()) return "";
+            code += hit->second;
+            at = dash + 1;
+        }
+    }
+    if (code.size() != 3 || (code[0] != 'R' && code[0] != 'L') || (code[1] != 'A' && code[1] != 'P') ||
+        (code[2] != 'S' && code[2] != 'I')) {
+        return "";
+    }
+    return code;
+}
+
+/// The 4x4 index-to-world matrix of a volume: columns direction * spacing, then the origin.
+py::array affine_of(const Volume& v)
+{
+    py::array_t<double> a(std::vector<ssize>{4, 4});
+    auto r = a.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < 4; ++i) {
+        for (std::size_t j = 0; j < 4; ++j) {
+            double value = i == j ? 1.0 : 0.0;
+            if (i < 3 && j < 3) value = v.direction()[i][j] * v.spacing()[j];
+            if (i < 3 && j == 3) value = v.origin()[i];
+            r(static_cast<ssize>(i), static_cast<ssize>(j)) = value;
+        }
+    }
+    return a;
 }
 
 py::array matrix_of(const Mat3& m)
@@ -367,6 +413,14 @@ library's axis order x, y, z: world position of samples[k, j, i] = origin + dire
                                "3x3 array: column a is the world direction of +axis a (x, y, z)")
         .def_property_readonly("space", [](const Volume& v) { return v.space(); },
                                "the named space the file gave (\"left-posterior-superior\", \"RAI\", ...), or \"\"")
+        .def_property_readonly("space_code", [](const Volume& v) -> py::object {
+            const std::string code = space_code(v.space());
+            return code.empty() ? py::object(py::none()) : py::object(py::str(code));
+        }, "the world space as three letters (\"RAS\", \"LPS\", ...: where +x, +y, +z point), or None when the file names no anatomical space")
+        .def_property_readonly("frame_source", [](const Volume& v) { return v.frame_source(); },
+                               "where the reader took the frame from (\"sform (code 2: aligned)\", \"qform\", \"pixdim ...\", ...), or \"\"")
+        .def_property_readonly("affine", &affine_of,
+                               "4x4 array: world position of samples[k, j, i] = affine @ (i, j, k, 1) (columns i = x, j = y, k = z)")
         .def("__repr__", [](const Volume& v) {
             const Index3& d = v.dims();
             return "Volume(" + std::to_string(d[0]) + "x" + std::to_string(d[1]) + "x" + std::to_string(d[2]) + " " +
@@ -603,13 +657,27 @@ PYBIND11_MODULE(_cmc33, m)
           py::arg("descent"), py::arg("mask_cells"), py::arg("threads"), py::arg("progress"));
 
     m.def("read_volume", [](const std::filesystem::path& path, const std::optional<Index3>& dims, const std::string& type,
-                            const Vec3& spacing, const std::string& endian, std::uint64_t header_bytes) {
+                            const std::optional<Vec3>& spacing, const std::string& endian, std::uint64_t header_bytes,
+                            const std::optional<std::int64_t>& frame, const std::string& array, const std::string& series,
+                            const std::optional<Vec3>& origin) {
         std::optional<io::RawOptions> raw;
-        if (dims) raw = io::RawOptions{*dims, io::parse_type(type), spacing,
-                                       endian == "big" ? io::Endian::big : io::Endian::little, header_bytes};
+        io::ReadOptions options;
+        if (dims) {
+            raw = io::RawOptions{*dims, io::parse_type(type), spacing.value_or(Vec3{1, 1, 1}),
+                                 endian == "big" ? io::Endian::big : io::Endian::little, header_bytes};
+        } else {
+            options.spacing = spacing; // the frame of formats that have none (.npy, TIFF)
+            options.origin = origin;
+        }
+        options.frame = frame;
+        options.array = array;
+        options.series = series;
         py::gil_scoped_release nogil;
-        return io::read_volume(path, raw);
-    }, py::arg("path"), py::arg("dims"), py::arg("type"), py::arg("spacing"), py::arg("endian"), py::arg("header_bytes"));
+        return io::read_volume(path, raw, options);
+    }, py::arg("path"), py::arg("dims"), py::arg("type"), py::arg("spacing"), py::arg("endian"), py::arg("header_bytes"),
+       py::arg("frame"), py::arg("array"), py::arg("series"), py::arg("origin"));
+    m.def("convert_space", [](Volume& volume, const std::string& space) { io::convert_space(volume, space); },
+          py::arg("volume"), py::arg("space"));
     m.def("write_volume", [](const Volume& v, const std::filesystem::path& path) {
         py::gil_scoped_release nogil;
         io::write_volume(v, path);

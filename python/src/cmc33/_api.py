@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 from typing import Any, Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -11,13 +12,15 @@ from . import _cmc33
 from ._arrays import IDENTITY, as_samples, mat3, method_name, raise_non_finite, thread_count, vec3
 from ._cmc33 import (CellReport, FieldTopology, Mesh, MeshGeometry, MeshTopology, VerifyReport,
                      Volume)
-from ._errors import NonFiniteError
+from ._errors import Error, InvalidArgumentError, NonFiniteError
 
 PathLike = Union[str, "os.PathLike[str]"]
 #: A Mesh, or arrays (vertices, triangles[, normals, ...]) such as marching_cubes returns.
 MeshLike = Union[Mesh, Sequence[Any]]
 
 METHODS: Tuple[str, ...] = tuple(_cmc33.method_names())
+#: A command-line option in a reader's message ("--frame N", "--space"), as read_volume's argument.
+_OPTION = re.compile(r"--(frame|array|series|spacing|origin|space)\b(?: (N|NAME|UID))?")
 
 
 def _method(method: str) -> str:
@@ -121,19 +124,61 @@ def extract(volume: Union[Volume, Any], iso: float, *, spacing: Optional[Sequenc
         raise
 
 
-def read_volume(path: PathLike, *, dims: Optional[Sequence[int]] = None, dtype: Any = None,
-                spacing: Sequence[float] = (1., 1., 1.), endian: str = "little", header_bytes: int = 0) -> Volume:
-    """Reads a volume file: NRRD (.nrrd, .nhdr), MetaImage (.mhd, .mha), VTK legacy (.vtk).
+def read_volume(path: PathLike, *, frame: Optional[int] = None, array: Optional[str] = None,
+                series: Optional[str] = None, space: Optional[str] = None,
+                spacing: Optional[Sequence[float]] = None, origin: Optional[Sequence[float]] = None,
+                dims: Optional[Sequence[int]] = None, dtype: Any = None, endian: str = "little",
+                header_bytes: int = 0) -> Volume:
+    """Reads a volume as ``cmc33 extract`` and ``cmc33 info`` read it, the format told by the
+    file's content before its name: NRRD (.nrrd, .nhdr), MetaImage (.mhd, .mha), VTK legacy (.vtk),
+    NIfTI-1 and -2 (.nii, .nii.gz, .hdr + .img), NumPy (.npy), VTK XML ImageData (.vti), TIFF (a
+    multi-page file or a folder of slices) and DICOM (a folder of slice files, a DICOMDIR or a
+    multi-frame file; only when the package was built with GDCM, -DCMC33_WITH_GDCM=ON, else
+    UnsupportedFormatError says so).
 
-    Returns a Volume: ``volume.samples`` is the (nz, ny, nx) array over the library's memory (no
-    copy), ``volume.spacing``, ``origin``, ``direction`` and ``space`` its frame, in the library's
-    axis order x, y, z (x is the array's last axis). ``extract(volume, iso)`` uses that frame, as
-    the command line does.
+    Returns a Volume:
 
-    A headerless raw file (any other name) needs ``dims`` (x, y, z), ``dtype`` (a numpy type or
-    "uint16", ...), and optionally ``spacing``, ``endian`` ('little' or 'big') and
-    ``header_bytes`` to skip. Errors name the file, what is wrong and what was expected
-    (FileError is an OSError; the format errors are ValueErrors).
+    * ``volume.samples``: the numpy array of shape (nz, ny, nx) over the library's memory (no
+      copy): ``samples[k, j, i]`` is sample (i, j, k), x (the file's fastest axis) being the
+      array's last axis. For a NIfTI file that is nibabel's ``img.get_fdata()`` transposed
+      (``.T``); for a .npy file of shape (nz, ny, nx) it is that array.
+    * ``volume.affine``: 4x4, index to world: the world position of ``samples[k, j, i]`` is
+      ``affine @ (i, j, k, 1)``; its columns 0, 1, 2 are the steps along i = x, j = y, k = z, so it
+      equals nibabel's ``img.affine`` for a NIfTI file. The same frame in parts:
+      ``spacing``, ``origin`` and ``direction`` (x, y, z order).
+    * ``volume.space_code``: the world space, "RAS" (NIfTI: x to the right, y anterior, z
+      superior) or "LPS" (DICOM, NRRD's usual), or None when the file names no anatomical space
+      (.npy, .vti, TIFF, a NIfTI with neither sform nor qform); ``volume.space`` is the name as the
+      file gave it.
+    * ``volume.frame_source``: where the frame came from ("sform (code 2: aligned)", "qform",
+      "ImagePositionPatient/ImageOrientationPatient", "Origin, Spacing, Direction", ...).
+
+    ``extract(volume, iso)`` uses that frame and places the vertices where ``cmc33 extract``
+    places them for the same file and options.
+
+    Parameters
+    ----------
+    frame : int, optional
+        4-D files (NIfTI with dim[4] > 1, a 4-D .npy): the frame to read, from 0 (nibabel's
+        ``img.dataobj[..., frame]``); required when the file holds several.
+    array : str, optional
+        .vti: the point-data array to read (default: the active scalars, else the only array).
+    series : str, optional
+        DICOM: the SeriesInstanceUID to read when the input holds several series.
+    space : {'ras', 'lps'}, optional
+        Moves the frame into that world space (negating x and y between RAS and LPS), as
+        ``--space``; refused for a file that names no anatomical space. Default: the file's own.
+    spacing, origin : 3 floats, optional
+        The frame of formats that give none (.npy, TIFF; in x, y, z order), as ``--spacing`` and
+        ``--origin``; refused for formats that give their own. For a headerless raw file,
+        ``spacing`` is its spacing.
+    dims, dtype, endian, header_bytes
+        A headerless raw file (any name the formats above do not claim) needs ``dims`` (x, y,
+        z) and ``dtype`` (a numpy type or "uint16", ...), and optionally ``endian`` ('little' or
+        'big') and ``header_bytes`` to skip.
+
+    Errors name the file, what is wrong and what was expected (FileError is an OSError; the
+    format errors are ValueErrors).
     """
     raw_dims = None
     type_name = "uint8"
@@ -146,8 +191,38 @@ def read_volume(path: PathLike, *, dims: Optional[Sequence[int]] = None, dtype: 
         type_name = np.dtype(dtype).name if not isinstance(dtype, str) else dtype
         if endian not in ("little", "big"):
             raise ValueError(f"endian {endian!r}; expected 'little' or 'big'")
-    return _cmc33.read_volume(os.fspath(path), raw_dims, type_name, vec3(spacing, "spacing"), endian,
-                              int(header_bytes))
+        if origin is not None:
+            raise ValueError("origin is for .npy and TIFF files; a headerless raw volume starts at 0")
+    elif dtype is not None:
+        raise ValueError("dtype is for headerless raw files, with dims; a file with a header gives its type")
+    if frame is not None and (isinstance(frame, bool) or int(frame) != frame or frame < 0):
+        raise ValueError(f"frame {frame!r}; expected a whole number from 0")
+    for name, text in (("array", array), ("series", series)):
+        if text is not None and (not isinstance(text, str) or not text):
+            raise ValueError(f"{name} {text!r}; expected a non-empty string")
+    target = None
+    if space is not None:
+        target = str(space).lower()
+        if target not in ("ras", "lps"):
+            raise ValueError(f"space {space!r}; expected 'ras' or 'lps'")
+    try:
+        volume = _cmc33.read_volume(os.fspath(path), raw_dims, type_name,
+                                    None if spacing is None else vec3(spacing, "spacing"), endian, int(header_bytes),
+                                    None if frame is None else int(frame), array or "", series or "",
+                                    None if origin is None else vec3(origin, "origin"))
+    except Error as e:
+        # the readers' messages name the command line's options; here they are arguments
+        text = _OPTION.sub(lambda m: f"{m[1]}={m[2] or ''}", str(e))
+        if text == str(e):
+            raise
+        raise type(e)(text) from None
+    if target is not None:
+        if volume.space_code is None:
+            raise InvalidArgumentError(
+                f"{os.fspath(path)}: the file names no anatomical space (its frame has no orientation: "
+                f"{volume.frame_source or 'no frame'}), so it cannot be converted to {target.upper()}; leave out space=")
+        _cmc33.convert_space(volume, target)
+    return volume
 
 
 def write_volume(volume: Union[Volume, Any], path: PathLike, *, spacing: Optional[Sequence[float]] = None,
