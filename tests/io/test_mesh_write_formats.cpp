@@ -14,12 +14,14 @@
 #include <cstring>
 #include <filesystem>
 #include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/mesh.hpp"
+#include "mesh_formats.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -102,6 +104,35 @@ TEST(MeshWriteFormats, GlbChunksAlignedAndJsonComplete)
     for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(f32(bytes, p_at + 4 * i), m.positions[i]);
     const std::size_t t_at = data + j["bufferViews"][idx["bufferView"].get<int>()]["byteOffset"].get<std::size_t>();
     for (std::size_t i = 0; i < 9; ++i) EXPECT_EQ(u32(bytes, t_at + 4 * i), m.triangles[i]);
+}
+
+TEST(MeshWriteFormats, GlbPartsHaveTheirNodesMeshesAndColours)
+{
+    // The per-label layout: one node, mesh and material per part, in the parts' order.
+    const Mesh a = tetra(false);
+    Mesh b = tetra(true);
+    for (float& x : b.positions) x += 10;
+    const std::vector<cmc33::io::detail::GltfPart> parts{{&a, "label 1", std::array<float, 4>{1, 0, 0, 1}},
+                                                         {&b, "label \"2\"", std::array<float, 4>{0, 0.5f, 1, 0.25f}}};
+    std::ostringstream out;
+    cmc33::io::detail::write_glb(parts, out, {}, "parts.glb");
+    const std::string bytes = out.str();
+    ASSERT_EQ(u32(bytes, 8), bytes.size());
+    const json j = json::parse(bytes.substr(20, u32(bytes, 12)));
+    ASSERT_EQ(j["nodes"].size(), 2u);
+    ASSERT_EQ(j["meshes"].size(), 2u);
+    ASSERT_EQ(j["materials"].size(), 2u);
+    EXPECT_EQ(j["scenes"][0]["nodes"], json::array({0, 1}));
+    EXPECT_EQ(j["nodes"][1]["name"], "label \"2\"");
+    EXPECT_EQ(j["meshes"][1]["primitives"][0]["material"], 1);
+    EXPECT_EQ(j["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"], json::array({1.0, 0.0, 0.0, 1.0}));
+    EXPECT_FALSE(j["materials"][0].contains("alphaMode"));
+    EXPECT_EQ(j["materials"][1]["alphaMode"], "BLEND");
+    EXPECT_EQ(j["accessors"][j["meshes"][1]["primitives"][0]["attributes"]["POSITION"].get<int>()]["min"],
+              json::array({10.0, 10.0, 10.0}));
+    EXPECT_FALSE(j["meshes"][0]["primitives"][0]["attributes"].contains("NORMAL"));
+    EXPECT_TRUE(j["meshes"][1]["primitives"][0]["attributes"].contains("NORMAL"));
+    EXPECT_EQ(j["buffers"][0]["byteLength"], 4 * (12 + 9) + 4 * (12 + 12 + 9));
 }
 
 TEST(MeshWriteFormats, GltfWithBinBesideIt)
