@@ -14,10 +14,11 @@ void add_cell(CLI::App& app);
 void add_verify(CLI::App& app);
 void add_dataset(CLI::App& app);
 void add_sweep(CLI::App& app);
+void add_simplify(CLI::App& app);
 
 using AddCommand = void (*)(CLI::App&);
 
 /// Every command, in the order `cmc33 --help` lists them.
-inline constexpr AddCommand kCommands[] = {add_extract, add_info, add_topo, add_cell, add_verify, add_dataset, add_sweep};
+inline constexpr AddCommand kCommands[] = {add_extract, add_info, add_topo, add_cell, add_verify, add_dataset, add_sweep, add_simplify};
 
 } // namespace cmc33::cli
