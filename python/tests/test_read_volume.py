@@ -297,3 +297,15 @@ def test_bad_arguments(tmp_path):
         cmc33.read_volume(path, array="")
     with pytest.raises(ValueError, match="origin is for"):
         cmc33.read_volume(tmp_path / "x.raw", dims=(2, 2, 2), dtype="uint8", origin=(1, 2, 3))
+
+
+@pytest.mark.parametrize("suffix", [".hdr", ".hdr.gz"])
+def test_nifti_pairs(nib, cli, tmp_path, suffix):
+    """A .hdr/.img pair, and a compressed .hdr.gz/.img.gz pair, as nibabel writes them."""
+    samples = ball().astype(np.float32)
+    nib.save(nib.Nifti1Pair(samples.T, oblique_affine()), tmp_path / ("pair" + suffix))
+    back = nib.load(tmp_path / ("pair" + suffix))
+    volume = cmc33.read_volume(tmp_path / ("pair" + suffix))
+    assert np.array_equal(volume.samples, np.asarray(back.dataobj).T)
+    assert np.allclose(volume.affine, back.affine, rtol=0, atol=1e-12)
+    same_mesh_as_cli(cli, tmp_path, tmp_path / ("pair" + suffix), volume, 0.0)

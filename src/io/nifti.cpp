@@ -1,6 +1,7 @@
 // NIfTI-1 (nifti.nimh.nih.gov/nifti-1, the header nifti1.h documents: 348 bytes) and NIfTI-2
 // (nifti2.h: 540 bytes, 64-bit dims and offsets, double fields): a single file .nii ("n+1",
-// "n+2"), gzip-compressed or not, or a header .hdr ("ni1", "ni2") whose samples are in <stem>.img.
+// "n+2"), gzip-compressed or not, or a header .hdr ("ni1", "ni2") whose samples are in <stem>.img
+// (a .hdr.gz header: in <stem>.img.gz, compressed as well).
 // Written for cmc33 from those headers' documentation.
 //
 // Byte order: sizeof_hdr (348 or 540) read in either order says it. The frame, in the order
@@ -419,11 +420,14 @@ Volume read_nifti(const ByteInput& file, const OpenDataFile& open_data, const Re
 
     std::unique_ptr<ByteInput> data_file;
     if (!h.single_file) {
-        const std::string stem = std::filesystem::path(label).stem().string();
-        data_file = open_data(stem + ".img");
+        // x.hdr -> x.img; a compressed x.hdr.gz -> x.img.gz, compressed too (as nibabel writes pairs)
+        std::filesystem::path stem = std::filesystem::path(label).stem();
+        if (header_compressed && lower_ascii(stem.extension().string()) == ".hdr") stem = stem.stem();
+        data_file = open_data(stem.string() + (header_compressed ? ".img.gz" : ".img"));
     }
     const ByteInput& data = data_file ? *data_file : file;
-    const bool compressed = !data_file && header_compressed; // a pair's .img is read as it is
+    // a single file is compressed when its header is, and so is the .img.gz of a compressed pair
+    const bool compressed = header_compressed;
     const std::string what = frames == 1 ? str_cat(dims_text(grid.dims), ' ', type->name)
                                          : str_cat(frames, " frames of ", dims_text(grid.dims), ' ', type->name);
 
