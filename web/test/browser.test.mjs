@@ -318,6 +318,30 @@ test('a volume dropped on the page (file input) is read and extracted', async ()
   assert.deepEqual(await volumeCounts(), cliCounts(cliExtract(BUCKY, iso, 'cmc33')));
 });
 
+test('a NIfTI, a .npy and a .vti dropped on the page are read in their frame and extracted; a TIFF gets a message', async () => {
+  // the fuzz corpus's seeds: one byte of the fuzz target's options, then the file
+  const corpus = (f) => {
+    const file = path.join(fixture.dir, path.basename(f));
+    fs.writeFileSync(file, fs.readFileSync(path.join(ROOT, 'fuzz/corpus', f)).subarray(1));
+    return file;
+  };
+  for (const [name, frame] of [['nifti/n1_gz.nii.gz', /frame: RAS, from (sform|qform)/], ['nifti/n2_sform.nii', /frame: RAS, from sform/],
+    ['npy/array_1_f8_F.npy', /values/], ['vti/image_4_appended_zlib.vti', /frame: from Origin, Spacing/]]) {
+    await open('#view=volume', (r) => r === 'volume');
+    await (await page.$('#volume-file')).uploadFile(corpus(name));
+    const base = path.basename(name);
+    await page.waitForFunction((b) => document.body.dataset.ready?.startsWith(`volume file:${b}`) || document.body.dataset.ready === 'volume error', {}, base);
+    assert.equal(await text('#volume-error'), '', name);
+    assert.match(await text('#volume-about'), frame, name);
+    const iso = Number(await page.$eval('#volume-iso', (e) => e.value));
+    assert.deepEqual(await volumeCounts(), cliCounts(cliExtract(corpus(name), iso, 'cmc33')), name);
+  }
+  await open('#view=volume', (r) => r === 'volume');
+  await (await page.$('#volume-file')).uploadFile(corpus('tiff/uint8.tif'));
+  await page.waitForFunction(() => document.body.dataset.ready === 'volume error');
+  assert.match(await text('#volume-error'), /^uint8\.tif: a TIFF file, which this page cannot read: its WebAssembly build has no TIFF reader/);
+});
+
 test('a failed file load clears the previous volume\'s description, histogram, counts and mesh', async () => {
   await open('#view=volume&volume=Bucky_32x32x32_uint8.nrrd&iso=100', (r) => r?.startsWith('volume Bucky'));
   assert.match(await text('#volume-about'), /^Bucky/);

@@ -136,3 +136,97 @@ test('errors arrive as JavaScript Errors with the library\'s one-line message', 
   const cut = fs.readFileSync(BUCKY).subarray(0, 5000);
   assert.throws(() => cmc33.Volume.read(cut, 'cut.nrrd', {}), /cut\.nrrd: /);
 });
+
+/** The vertices of `cmc33 extract FILE --iso ISO --ascii` (x y z per vertex), from the CLI's PLY. */
+function cliPositions(file, iso, extra = []) {
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cmc33-ply-'));
+  try {
+    const out = path.join(dir, 'm.ply');
+    execFileSync(CLI, ['extract', file, '--iso', String(iso), '-o', out, '--ascii', '--threads', '1', '--quiet', ...extra]);
+    const text = fs.readFileSync(out, 'utf8');
+    const header = text.slice(0, text.indexOf('end_header\n'));
+    const count = Number(/element vertex (\d+)/.exec(header)[1]);
+    const lines = text.slice(header.length + 'end_header\n'.length).split('\n');
+    const positions = new Float64Array(3 * count);
+    for (let v = 0; v < count; ++v) lines[v].split(' ').slice(0, 3).forEach((w, a) => (positions[3 * v + a] = Number(w)));
+    return positions;
+  } finally {
+    fs.rmSync(dir, { recursive: true, force: true });
+  }
+}
+
+test('NIfTI (.nii, .nii.gz, .hdr + .img), .npy and .vti files give the CLI\'s meshes, in the file\'s world frame', () => {
+  // the fuzz corpus's seeds: one byte of the fuzz target's options (frame, array), then the file
+  const seeds = fs.mkdtempSync(path.join(os.tmpdir(), 'cmc33-seeds-'));
+  const corpus = (f) => {
+    const file = path.join(seeds, path.basename(f));
+    fs.writeFileSync(file, fs.readFileSync(path.join(ROOT, 'fuzz/corpus', f)).subarray(1));
+    return file;
+  };
+  const cases = [
+    ['nifti/n1_float32.nii'], ['nifti/n2_sform.nii'], ['nifti/n1_qform_only.nii'], ['nifti/n1_gz.nii.gz'], ['nifti/n1_scaled.nii'],
+    ['nifti/n1_big_endian.nii'], ['npy/array_0_f4_C.npy'], ['npy/array_1_f8_F.npy'], ['vti/image_0_ascii.vti'],
+    ['vti/image_2_binary_zlib.vti'], ['vti/image_4_appended_zlib.vti'],
+  ];
+  let framed = 0, triangles = 0;
+  for (const [name] of cases) {
+    const file = corpus(name);
+    const volume = read(file);
+    try {
+      const { min, max } = volume.histogram(4);
+      const iso = (min + max) / 2 + 0.25 * (max - min) / 7;
+      assert.deepEqual(wasmCounts(volume, iso, 'cmc33'), cliCounts(cliExtract(file, iso, 'cmc33')), name);
+      const mesh = volume.extract(iso, 'cmc33');
+      const positions = mesh.positions().slice();
+      mesh.delete();
+      const want = cliPositions(file, iso);
+      assert.equal(positions.length, want.length, name);
+      triangles += positions.length;
+      let err = 0, scale = 1;
+      for (let i = 0; i < want.length; ++i) {
+        err = Math.max(err, Math.abs(positions[i] - want[i]));
+        scale = Math.max(scale, Math.abs(want[i]));
+      }
+      assert.ok(err <= 1e-6 * scale, `${name}: positions differ from the CLI's by ${err}`);
+      const identity = volume.direction().every((row, r) => row.every((x, c) => x === (r === c ? 1 : 0)));
+      if (!identity || volume.origin().some((x) => x !== 0)) ++framed;
+    } finally {
+      volume.delete();
+    }
+  }
+  assert.ok(framed >= 3, `${framed} of the files have a frame other than the identity: the frame is applied`);
+  assert.ok(triangles > 0, 'some of the meshes are not empty');
+  // the page reads a NIfTI pair as the CLI does: the header, with the .img as its data file
+  // (made from a single file: magic ni1, vox_offset 0, the samples after vox_offset in the .img)
+  const single = fs.readFileSync(corpus('nifti/n1_float32.nii'));
+  const voxOffset = single.readFloatLE(108);
+  const header = Buffer.from(single.subarray(0, 348));
+  header.writeFloatLE(0, 108);
+  header.write('ni1\0', 344, 'latin1');
+  const dir = fs.mkdtempSync(path.join(os.tmpdir(), 'cmc33-pair-'));
+  fs.writeFileSync(path.join(dir, 'pair.hdr'), header);
+  fs.writeFileSync(path.join(dir, 'pair.img'), single.subarray(voxOffset));
+  const pair = cmc33.Volume.read(header, 'pair.hdr', { 'pair.img': single.subarray(voxOffset) });
+  const { min, max } = pair.histogram(4);
+  const iso = (min + max) / 2 + 0.01;
+  assert.deepEqual(wasmCounts(pair, iso, 'cmc33'), cliCounts(cliExtract(path.join(dir, 'pair.hdr'), iso, 'cmc33')));
+  const whole = read(corpus('nifti/n1_float32.nii'));
+  assert.deepEqual([pair.space(), pair.origin(), pair.direction()], [whole.space(), whole.origin(), whole.direction()]);
+  whole.delete();
+  pair.delete();
+  fs.rmSync(dir, { recursive: true, force: true });
+  // a 4-D file needs a frame, which the page cannot choose: the library's message says so
+  assert.throws(() => read(corpus('nifti/n1_4d_frame1.nii')), /n1_4d_frame1\.nii: .*frame/);
+  fs.rmSync(seeds, { recursive: true, force: true });
+});
+
+test('TIFF and DICOM files get a message that the page cannot read them', () => {
+  const tiff = path.join(ROOT, 'fuzz/corpus/tiff/uint8.tif');
+  assert.throws(() => read(tiff), /^Error: uint8\.tif: a TIFF file, which this page cannot read: its WebAssembly build has no TIFF reader/);
+  // by the mark, whatever the name
+  assert.throws(() => cmc33.Volume.read(fs.readFileSync(tiff), 'slice_001', {}), /slice_001: a TIFF file, which this page cannot read/);
+  const dicom = fs.readdirSync(path.join(ROOT, 'fuzz/corpus/dicom')).map((f) => path.join(ROOT, 'fuzz/corpus/dicom', f))
+    .find((f) => fs.statSync(f).isFile() && fs.readFileSync(f).subarray(128, 132).toString('latin1') === 'DICM');
+  assert.ok(dicom, 'a DICOM file in fuzz/corpus/dicom');
+  assert.throws(() => cmc33.Volume.read(fs.readFileSync(dicom), 'IM0001', {}), /IM0001: a DICOM file, which this page cannot read: its WebAssembly build has no DICOM reader/);
+});

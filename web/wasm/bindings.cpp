@@ -196,22 +196,38 @@ class WebVolume {
 public:
     explicit WebVolume(cmc33::Volume volume) : volume_(std::move(volume)) {}
 
-    /// Reads a volume file from its bytes; `name` tells the format by its extension (.nrrd, .nhdr,
-    /// .mha, .mhd, .vtk) and `files` (an object: name -> Uint8Array) holds a detached header's data files.
+    /// Reads a volume file from its bytes; the format is told by the content where it has a mark
+    /// (NIfTI, .npy, TIFF, DICOM), else by `name`'s extension (.nrrd, .nhdr, .mha, .mhd, .vtk, .nii,
+    /// .nii.gz, .hdr, .npy, .vti). `files` (an object: name -> Uint8Array) holds a detached header's
+    /// data files (NRRD, MetaImage, a NIfTI .hdr's .img).
     static std::unique_ptr<WebVolume> read(const std::string& bytes, const std::string& name, const val& files)
     {
     return guard([&] {
-        const std::string ext = name.substr(std::min(name.size(), name.rfind('.') == std::string::npos ? name.size() : name.rfind('.')));
         std::string lower;
-        for (const char c : ext) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
-        cmc33::io::VolumeFormat format = cmc33::io::VolumeFormat::nrrd;
-        if (lower == ".mha" || lower == ".mhd") {
-            format = cmc33::io::VolumeFormat::metaimage;
-        } else if (lower == ".vtk") {
-            format = cmc33::io::VolumeFormat::vtk;
-        } else if (lower != ".nrrd" && lower != ".nhdr") {
+        for (const char c : name) lower += static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+        const auto ends = [&](std::string_view suffix) { return lower.ends_with(suffix); };
+        const auto has = [&](std::size_t at, std::string_view mark) { return bytes.size() >= at + mark.size() && std::string_view(bytes).substr(at, mark.size()) == mark; };
+        using cmc33::io::VolumeFormat;
+        VolumeFormat format = VolumeFormat::nrrd;
+        if (has(0, "\x93NUMPY") || ends(".npy")) {
+            format = VolumeFormat::npy;
+        } else if (has(0, "II*") || has(0, std::string_view("MM\0*", 4)) || has(0, "II+") || has(0, std::string_view("MM\0+", 4)) || ends(".tif") || ends(".tiff")) {
+            format = VolumeFormat::tiff;
+        } else if (has(128, "DICM") || ends(".dcm")) {
+            format = VolumeFormat::dicom;
+        } else if (has(344, std::string_view("n+1\0", 4)) || has(344, std::string_view("ni1\0", 4)) || has(4, std::string_view("n+2\0", 4)) ||
+                   has(4, std::string_view("ni2\0", 4)) || ends(".nii") || ends(".nii.gz") || ends(".hdr") || ends(".hdr.gz")) {
+            format = VolumeFormat::nifti;
+        } else if (ends(".vti")) {
+            format = VolumeFormat::vti;
+        } else if (ends(".mha") || ends(".mhd")) {
+            format = VolumeFormat::metaimage;
+        } else if (ends(".vtk")) {
+            format = VolumeFormat::vtk;
+        } else if (!ends(".nrrd") && !ends(".nhdr")) {
             throw cmc33::Error(cmc33::Status::unsupported_format,
-                               name + ": unknown volume extension; expected .nrrd, .nhdr, .mha, .mhd or .vtk");
+                               name + ": unknown volume extension; expected .nrrd, .nhdr, .mha, .mhd, .vtk, .nii, .nii.gz, "
+                                      ".hdr (+ .img), .npy or .vti");
         }
         std::map<std::string, std::string, std::less<>> data;
         if (!files.isUndefined() && !files.isNull()) {
@@ -228,7 +244,19 @@ public:
             if (it == data.end()) return std::nullopt;
             return std::string_view(it->second);
         };
-        return std::make_unique<WebVolume>(cmc33::io::read_volume_from_memory(bytes, format, name, std::nullopt, serve));
+        try {
+            return std::make_unique<WebVolume>(cmc33::io::read_volume_from_memory(bytes, format, name, std::nullopt, serve));
+        } catch (const cmc33::Error& e) {
+            // this build compiles neither libtiff nor GDCM: say so in the page's words, not the CLI's
+            const bool image = format == VolumeFormat::tiff || format == VolumeFormat::dicom;
+            if (!image || e.status() != cmc33::Status::unsupported_format || std::string_view(e.what()).find("this build") == std::string_view::npos) throw;
+            const std::string what = format == VolumeFormat::tiff ? "TIFF" : "DICOM";
+            throw cmc33::Error(cmc33::Status::unsupported_format,
+                               name + ": a " + what + " file, which this page cannot read: its WebAssembly build has no " + what +
+                                   " reader (" + (format == VolumeFormat::tiff ? "libtiff" : "GDCM") +
+                                   " is not compiled into it); read it with the command-line tool (cmc33 extract), or convert it to "
+                                   "NIfTI or NRRD and drop that");
+        }
     });
 }
 
@@ -260,6 +288,27 @@ public:
         return o;
     }
     std::string type() const { return std::string(cmc33::type_name(volume_.type())); }
+    val origin() const
+    {
+        val o = val::array();
+        for (const auto x : volume_.origin()) o.call<void>("push", x);
+        return o;
+    }
+    /// Row by row: column a is the world direction of +axis a.
+    val direction() const
+    {
+        val o = val::array();
+        for (const auto& row : volume_.direction()) {
+            val r = val::array();
+            for (const auto x : row) r.call<void>("push", x);
+            o.call<void>("push", r);
+        }
+        return o;
+    }
+    /// The world space the file names ("right-anterior-superior", ...), or "".
+    std::string space() const { return volume_.space(); }
+    /// Where the reader took the frame from ("sform (code 2: aligned)", ...), or "".
+    std::string frame_source() const { return volume_.frame_source(); }
 
     /// {min, max, counts: Float64Array(bins)} over [min, max] of the finite samples.
     val histogram(int bins) const
@@ -465,6 +514,10 @@ EMSCRIPTEN_BINDINGS(cmc33)
         .function("dims", &WebVolume::dims)
         .function("spacing", &WebVolume::spacing)
         .function("type", &WebVolume::type)
+        .function("origin", &WebVolume::origin)
+        .function("direction", &WebVolume::direction)
+        .function("space", &WebVolume::space)
+        .function("frameSource", &WebVolume::frame_source)
         .function("histogram", &WebVolume::histogram)
         .function("extract", &WebVolume::extract)
         .function("fieldTopology", &WebVolume::field_topology)

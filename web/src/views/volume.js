@@ -1,4 +1,5 @@
-// Volumes (Fig. 12): a NRRD / MetaImage / VTK file dropped on the page or one of the bundled ones,
+// Volumes (Fig. 12): a NRRD / MetaImage / VTK / NIfTI / .npy / .vti file dropped on the page or one
+// of the bundled ones, extracted in its own world frame (the file's origin, spacing and direction),
 // an isovalue picked on its histogram, extracted in the browser by any method (and a second one
 // beside it), its components coloured as in Fig. 12 (the largest yellow, the others purple), its
 // topology and the time taken. The Fig. 12 link opens the aneurism at iso 78 with mc33-lewiner
@@ -9,6 +10,10 @@ import { Viewer, surface, linkCameras } from '../viewer.js';
 import { takeMesh } from '../cmc33.js';
 import fig12 from '../../../docs/figures/fig12_render.json';
 
+// headers and single-file volumes, then the files a page build cannot read but names (TIFF, DICOM)
+const HEADER_NAMES = /\.(nrrd|nhdr|mha|mhd|vtk|nii|nii\.gz|hdr|hdr\.gz|npy|vti)$/i;
+const OTHER_NAMES = /\.(tiff?|dcm)$/i;
+const VOLUME_EXTENSIONS = '.nrrd, .nhdr, .mha, .mhd, .vtk, .nii, .nii.gz, .hdr, .npy or .vti';
 const FIELD_TOPOLOGY_LIMIT = 20e6; // samples: the trilinear field's topology is computed without asking below this
 const FIG12_VOLUME = 'aneurism_256x256x256_uint8.nrrd';
 export const FIG12_LINK = `#view=volume&volume=${FIG12_VOLUME}&iso=${fig12.iso}&method=mc33-lewiner&compare=cmc33&zoom=fig12`;
@@ -24,6 +29,22 @@ async function bundledVolumes() {
   } catch {
     return [];
   }
+}
+
+/** The volume's world frame, as `cmc33 info` names it: "; frame: RAS, from sform (code 2: aligned)". */
+function frameText(volume) {
+  const words = { right: 'R', left: 'L', anterior: 'A', posterior: 'P', superior: 'S', inferior: 'I' };
+  const space = volume.space();
+  const code = space.split('-').map((w) => words[w.toLowerCase()] ?? '').join('');
+  const parts = [];
+  if (space) parts.push(code.length === 3 ? code : space);
+  if (volume.frameSource()) parts.push(`from ${volume.frameSource()}`);
+  const spacing = volume.spacing(), origin = volume.origin();
+  const moved = origin.some((x) => x !== 0) || spacing.some((x) => x !== 1) ||
+    volume.direction().some((row, r) => row.some((x, c) => x !== (r === c ? 1 : 0)));
+  if (!moved && !parts.length) return '';
+  if (moved) parts.push(`origin ${origin.map((x) => fmt(x)).join(' ')}, spacing ${spacing.map((x) => fmt(x)).join(' ')}`);
+  return `; frame: ${parts.join(', ')}`;
 }
 
 export function volumeView(root, cmc33, state, setState, report = () => {}) {
@@ -55,7 +76,8 @@ export function volumeView(root, cmc33, state, setState, report = () => {}) {
   const claim = el('p', { class: 'claim' },
     'Fig. 12 of the paper: on the aneurysm, VTK\'s Marching Cubes and MC33 break the main artery into extra ' +
     'components (purple) that C-MC33 keeps joined to it (yellow). Here the library runs in the page on any ' +
-    'volume: pick one or drop a .nrrd / .nhdr (+ data file) / .mha / .mhd (+ .raw) / .vtk file, choose an isovalue ' +
+    'volume: pick one or drop a .nrrd / .nhdr (+ data file) / .mha / .mhd (+ .raw) / .vtk / .nii / .nii.gz / .hdr (+ .img) / ' +
+    '.npy / .vti file (the mesh is placed in the file\'s world frame), choose an isovalue ' +
     'on the histogram, and compare two methods side by side. The topology numbers are the mesh\'s (cmc33::mesh_topology); ' +
     '"trilinear field" is what the level set must have (cmc33::field_topology, computed from the samples alone). ');
   const select = el('select', { id: 'volume-select' }, el('option', { value: '' }, 'bundled volumes…'));
@@ -196,9 +218,12 @@ export function volumeView(root, cmc33, state, setState, report = () => {}) {
   async function loadFiles(files) {
     forget();
     error.textContent = '';
-    const header = files.find((f) => /\.(nrrd|nhdr|mha|mhd|vtk)$/i.test(f.name));
+    // the header of a detached pair first; TIFF and DICOM by name too, so that the module can say
+    // it has no reader for them (a DICOM slice often has no extension: a lone file is tried as it is)
+    const header = files.find((f) => HEADER_NAMES.test(f.name)) ?? files.find((f) => OTHER_NAMES.test(f.name)) ??
+      (files.length === 1 ? files[0] : undefined);
     if (!header) {
-      failed(`${files.map((f) => f.name).join(', ')}: no .nrrd, .nhdr, .mha, .mhd or .vtk file among them`);
+      failed(`${files.map((f) => f.name).join(', ')}: no volume file among them (expected one of ${VOLUME_EXTENSIONS})`);
       return;
     }
     const data = {};
@@ -221,7 +246,7 @@ export function volumeView(root, cmc33, state, setState, report = () => {}) {
         report(`zoom=fig12: the docs' Fig. 12 zoom is a place in ${FIG12_VOLUME}, not in ${shown}; the whole volume is shown.`);
       }
       const histogram = volume.histogram(256);
-      about.textContent = `${shown}: ${volume.dims().join('×')} ${volume.type()}, values ${fmt(histogram.min)} … ${fmt(histogram.max)} (read in ${readMs.toFixed(0)} ms)`;
+      about.textContent = `${shown}: ${volume.dims().join('×')} ${volume.type()}, values ${fmt(histogram.min)} … ${fmt(histogram.max)} (read in ${readMs.toFixed(0)} ms)${frameText(volume)}`;
       if (!Number.isFinite(iso) || iso < histogram.min || iso > histogram.max) iso = Number(((histogram.min + histogram.max) / 2).toPrecision(4));
       isoInput.value = iso;
       isoError.textContent = '';
@@ -234,7 +259,8 @@ export function volumeView(root, cmc33, state, setState, report = () => {}) {
       } });
       extract(true);
     } catch (e) {
-      failed(`${shown}: ${e.message}`);
+      // the library's messages start with the file's name already
+      failed(e.message.startsWith(`${shown}: `) ? e.message : `${shown}: ${e.message}`);
     }
   }
 
