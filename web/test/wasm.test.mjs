@@ -213,6 +213,14 @@ test('NIfTI (.nii, .nii.gz, .hdr + .img), .npy and .vti files give the CLI\'s me
   const whole = read(corpus('nifti/n1_float32.nii'));
   assert.deepEqual([pair.space(), pair.origin(), pair.direction()], [whole.space(), whole.origin(), whole.direction()]);
   whole.delete();
+  // and a compressed pair (.hdr.gz + .img.gz, as nibabel writes them), compressed here by Node's zlib
+  const [headerGz, imageGz] = [zlib.gzipSync(header), zlib.gzipSync(single.subarray(voxOffset))];
+  fs.writeFileSync(path.join(dir, 'packed.hdr.gz'), headerGz);
+  fs.writeFileSync(path.join(dir, 'packed.img.gz'), imageGz);
+  const packed = cmc33.Volume.read(headerGz, 'packed.hdr.gz', { 'packed.img.gz': imageGz });
+  assert.deepEqual(wasmCounts(packed, iso, 'cmc33'), wasmCounts(pair, iso, 'cmc33'));
+  assert.deepEqual(wasmCounts(packed, iso, 'cmc33'), cliCounts(cliExtract(path.join(dir, 'packed.hdr.gz'), iso, 'cmc33')));
+  packed.delete();
   pair.delete();
   fs.rmSync(dir, { recursive: true, force: true });
   // a 4-D file needs a frame, which the page cannot choose: the library's message says so
