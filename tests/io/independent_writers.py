@@ -159,6 +159,9 @@ def check_nifti(c):
     pair2 = nib.Nifti2Pair(data, sform)
     path, back = save(pair2, "pair2.hdr")
     c.compare("nifti2 pair .hdr", path, np.asanyarray(back.dataobj), 0.5, affine_map(back.affine))
+    # a compressed pair: nibabel writes pair.hdr.gz and pair.img.gz
+    path, back = save(nib.Nifti1Pair(data, sform), "packed.hdr.gz")
+    c.compare("nifti1 pair .hdr.gz + .img.gz", path, np.asanyarray(back.dataobj), 0.5, affine_map(back.affine))
     # scl_slope / scl_inter on stored int16, uint8 and int32
     for dtype, slope, inter in ((np.int16, 0.004, -1.5), (np.uint8, 0.01, -0.2), (np.int32, 2e-5, 0.25)):
         stored = np.round((data - data.min()) / (data.max() - data.min()) * (100 if dtype == np.uint8 else 1000)).astype(dtype)
