@@ -71,8 +71,9 @@ void run_simplify(const SimplifyArgs& args)
         throw UsageError("nothing to do: give --ratio R, --triangles N or --max-error E (and/or --smooth N, --largest, "
                          "--min-size N)");
     }
+    // a bad -o fails before any work (normals, if the input has them, are written where the format can hold them)
+    check_mesh_output(args.output, args.ascii, false, {args.input});
     const Mesh input = named_step(args.input, "reading the mesh", [&] { return io::read_mesh(args.input); });
-    check_mesh_output(args.output, args.ascii, input.has_normals(), {args.input});
     const auto start = std::chrono::steady_clock::now();
 
     Mesh mesh = input;
@@ -181,7 +182,7 @@ void add_simplify(CLI::App& app)
     cmd->add_option("-o,--output", args->output, "Write the result: .ply .obj .stl .off (by extension)")
         ->type_name("OUT")
         ->check(non_empty("a mesh file name"));
-    auto* ratio = cmd->add_option("--ratio", args->ratio, "Keep this fraction of the triangles (0 < R <= 1)")
+    auto* ratio = cmd->add_option("--ratio", args->ratio, "Keep this fraction of the triangles (of those --largest and --min-size keep; 0 < R <= 1)")
                       ->type_name("R")
                       ->check(CLI::Range(1e-9, 1.0));
     cmd->add_option("--triangles", args->triangles, "Stop at N triangles or fewer")
