@@ -94,9 +94,9 @@ void TriangleGrid::build(const std::vector<Pos>& pos, const std::vector<Tri>& tr
         cells_.resize(1);
         return;
     }
-    // cells about the mean edge: a triangle spans few cells, a cell holds few triangles; at most
+    // cells about twice the mean edge: a fan of triangles spans few cells, a cell holds few; at most
     // about four cells per live triangle (and never below 1 per axis)
-    double cell = edge_sum / static_cast<double>(3 * live);
+    double cell = 2 * edge_sum / static_cast<double>(3 * live);
     double extent[3];
     for (int k = 0; k < 3; ++k) extent[k] = static_cast<double>(hi[k]) - static_cast<double>(lo[k]);
     if (!(cell > 0)) cell = std::max({extent[0], extent[1], extent[2], 1.0});
