@@ -33,6 +33,8 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
+#include <optional>
 #include <numeric>
 #include <string>
 #include <type_traits>
@@ -137,6 +139,8 @@ struct Cut {
     std::int64_t num = 0, den = 1;
     double s = 0;
 };
+
+} // namespace
 
 /// A grid of double samples with, per axis, the original index coordinate of each plane.
 ///
@@ -280,6 +284,8 @@ struct RefinedGrid {
     }
 };
 
+namespace {
+
 /// The original index coordinate of refined index coordinate x along one axis.
 double unrefine(const std::vector<double>& coord, double x)
 {
@@ -378,15 +384,11 @@ template <class T> std::vector<SharedFace> shared_tunnel_faces(const GridView<T>
     return out;
 }
 
-template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats)
+template <class T> std::optional<Refinement> Refinement::of(const GridView<T>& grid, double iso)
 {
     std::vector<SharedFace> faces = shared_tunnel_faces(grid, iso);
-    if (faces.empty()) {
-        Mesh mesh = extract_passes(grid, iso, options, stats);
-        if (stats) stats->refinement_planes = 0;
-        return mesh;
-    }
-    RefinedGrid r = RefinedGrid::of(grid, iso);
+    if (faces.empty()) return std::nullopt;
+    auto r = std::make_shared<RefinedGrid>(RefinedGrid::of(grid, iso));
     std::int64_t planes = 0;
     for (int round = 0; !faces.empty(); ++round) {
         if (round == kMaxRefinementRounds) {
@@ -399,38 +401,39 @@ template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, con
         std::array<std::vector<Cut>, 3> cuts;
         for (const SharedFace& f : faces) {
             int along = 0;
-            const Cut cut = r.saddle_cut(f, along);
+            const Cut cut = r->saddle_cut(f, along);
             auto& list = cuts[static_cast<std::size_t>(along)];
             if (std::none_of(list.begin(), list.end(), [&](const Cut& c) { return c.slab == cut.slab; })) list.push_back(cut);
         }
         for (int b = 0; b < 3; ++b) {
             if (cuts[static_cast<std::size_t>(b)].empty()) continue;
             planes += static_cast<std::int64_t>(cuts[static_cast<std::size_t>(b)].size());
-            r.split(b, cuts[static_cast<std::size_t>(b)]);
+            r->split(b, cuts[static_cast<std::size_t>(b)]);
         }
-        faces = shared_tunnel_faces(r.view(), r.iso);
+        faces = shared_tunnel_faces(r->view(), r->iso);
     }
-    ExtractOptions refined_options = options;
-    refined_options.normals = false;
-    Mesh mesh = extract_passes(r.view(), r.iso, refined_options, stats);
-    if (stats) {
-        stats->refinement_planes = planes;
-        // the layout is the refined grid's, which the caller does not have
-        stats->plane_first_vertex.clear();
-        stats->plane_first_triangle.clear();
-    }
+    Refinement out;
+    out.grid_ = std::move(r);
+    out.planes_ = planes;
+    return out;
+}
 
+GridView<double> Refinement::view() const { return grid_->view(); }
+double Refinement::iso() const { return grid_->iso; }
+
+template <class T> void Refinement::map_back(const GridView<T>& grid, bool normals, Mesh& mesh) const
+{
     // back to the original grid's index space, then its world frame
     const Mat3 m = frame_matrix(grid.spacing, grid.direction);
     const Mat3 normal_map = inverse_transpose(m);
-    if (options.normals) mesh.normals.resize(mesh.positions.size());
+    if (normals) mesh.normals.resize(mesh.positions.size());
     for (std::size_t q = 0; q < mesh.vertex_count(); ++q) {
         double x[3];
-        for (std::size_t a = 0; a < 3; ++a) x[a] = unrefine(r.coord[a], static_cast<double>(mesh.positions[3 * q + a]));
+        for (std::size_t a = 0; a < 3; ++a) x[a] = unrefine(grid_->coord[a], static_cast<double>(mesh.positions[3 * q + a]));
         for (std::size_t c = 0; c < 3; ++c) {
             mesh.positions[3 * q + c] = static_cast<float>(grid.origin[c] + (m[c][0] * x[0] + m[c][1] * x[1] + m[c][2] * x[2]));
         }
-        if (options.normals) {
+        if (normals) {
             const auto n = normal_at(grid, normal_map, x);
             for (std::size_t c = 0; c < 3; ++c) mesh.normals[3 * q + c] = n[c];
         }
@@ -438,12 +441,12 @@ template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, con
     if (determinant(m) < 0) { // a mirroring frame: the winding rule holds in world space
         for (std::size_t t = 0; t < mesh.triangle_count(); ++t) std::swap(mesh.triangles[3 * t + 1], mesh.triangles[3 * t + 2]);
     }
-    return mesh;
 }
 
 #define CMC33_INSTANTIATE(T)                                                                                     \
     template std::vector<SharedFace> shared_tunnel_faces<T>(const GridView<T>&, double);                         \
-    template Mesh extract_refined<T>(const GridView<T>&, double, const ExtractOptions&, ExtractStats*);
+    template std::optional<Refinement> Refinement::of<T>(const GridView<T>&, double);                         \
+    template void Refinement::map_back<T>(const GridView<T>&, bool, Mesh&) const;
 CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 

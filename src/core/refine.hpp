@@ -12,6 +12,9 @@
 // two tunnels share one (C13: "in practice k = O(1)" splits), then extract from the refined grid.
 
 #include <cstdint>
+#include <cstdint>
+#include <memory>
+#include <optional>
 #include <vector>
 
 #include "cmc33/extract.hpp"
@@ -20,8 +23,8 @@
 
 namespace cmc33::detail {
 
-/// extract() without the dispatch to extract_refined(): the passes over `grid` as it is, with the
-/// method's decisions and table set (extract.cpp).
+/// extract()'s passes over `grid` as it is (no refinement), with the method's decisions and table
+/// set (extract.cpp).
 template <class T> Mesh extract_passes(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats);
 
 /// A grid face where two tunnels meet: the cells (i, j, k) and (i, j, k) + unit(axis) both have a
@@ -34,11 +37,28 @@ struct SharedFace {
 /// Every face of `grid` at `iso` where two tunnels meet, in (k, j, i, axis) order.
 template <class T> std::vector<SharedFace> shared_tunnel_faces(const GridView<T>& grid, double iso);
 
-/// Method cmc33_paper (extract.hpp): refines the grid where shared_tunnel_faces() finds faces, at
-/// most kMaxRefinementRounds times, and extracts from the refined grid; without such faces it is
-/// extract_passes() on `grid` itself. `stats`, if given, also gets the planes added.
-/// @throws Error{internal} if faces are still shared after kMaxRefinementRounds rounds
-template <class T> Mesh extract_refined(const GridView<T>& grid, double iso, const ExtractOptions& options, ExtractStats* stats);
+struct RefinedGrid; // refine.cpp
+
+/// Method cmc33_paper (extract.hpp): the grid refined where shared_tunnel_faces() finds faces (C13
+/// Sec. 6.2), at most kMaxRefinementRounds times; extract() runs the passes on view() at iso() and
+/// maps their mesh back to the original grid with map_back().
+class Refinement {
+public:
+    /// The refinement of `grid`, or none where no tunnels share a face (the grid as it is).
+    /// @throws Error{internal} if faces are still shared after kMaxRefinementRounds rounds
+    template <class T> static std::optional<Refinement> of(const GridView<T>& grid, double iso);
+    GridView<double> view() const;
+    double iso() const;
+    /// The planes added.
+    std::int64_t planes() const noexcept { return planes_; }
+    /// Takes a mesh of view() to `grid`'s index space and world frame, with normals from `grid`'s
+    /// samples when `normals`.
+    template <class T> void map_back(const GridView<T>& grid, bool normals, Mesh& mesh) const;
+
+private:
+    std::shared_ptr<const RefinedGrid> grid_;
+    std::int64_t planes_ = 0;
+};
 
 inline constexpr int kMaxRefinementRounds = 32;
 

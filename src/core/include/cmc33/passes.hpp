@@ -42,6 +42,10 @@
 
 namespace cmc33 {
 
+namespace detail {
+template <class T> class RangeExtractor; // src/core/range_extractor.hpp
+}
+
 /// What count() found in one range: the number of vertices and triangles, and per sample row the
 /// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row and
 /// one per cell with a face or interior test (its decision, which emit() replays).
@@ -69,7 +73,7 @@ public:
     void share_sample_bound(double bound) noexcept { largest_sample_ = bound > largest_sample_ ? bound : largest_sample_; }
 
 private:
-    template <class T> friend class RangeExtractor;
+    template <class T> friend class detail::RangeExtractor;
     struct Row { // 24 bytes: vertex ids fit 32 bits (a range's count is checked), triangles may not
         std::int64_t triangle_first = 0;
         std::uint32_t xy_first = 0; ///< first id of the row's x/y edge vertices (range-relative)

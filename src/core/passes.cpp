@@ -1,0 +1,105 @@
+// The public passes of passes.hpp (count, scan, emit_order, emit): the range extractor
+// (range_extractor.hpp) behind checks of what the caller hands it.
+
+#include <algorithm>
+#include <numeric>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cmc33/error.hpp"
+#include "cmc33/passes.hpp"
+#include "grid_checks.hpp"
+#include "range_extractor.hpp"
+#include "sample_types.hpp"
+
+namespace cmc33 {
+
+namespace {
+
+std::string range_text(std::int64_t k0, std::int64_t k1)
+{
+    return "[" + std::to_string(k0) + ", " + std::to_string(k1) + ")";
+}
+
+/// The passes run on the grid as it is; cmc33-paper may refine it first.
+void check_passes_method(const ExtractOptions& options, const char* pass)
+{
+    if (options.method == Method::cmc33_paper) {
+        throw Error(Status::invalid_argument, std::string(pass) +
+                                                  ": method cmc33-paper refines the grid first (Custodio et al. 2013, "
+                                                  "Sec. 6.2), which the passes cannot; use extract(), or another method");
+    }
+}
+
+} // namespace
+
+template <class T>
+RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1)
+{
+    check_passes_method(options, "count");
+    detail::check_grid(grid, iso);
+    if (!(0 <= k0 && k0 < k1 && k1 <= grid.nz())) {
+        throw Error(Status::invalid_argument, "count: sample planes " + range_text(k0, k1) + "; expected 0 <= k0 < k1 <= " +
+                                                  std::to_string(grid.nz()) + " (the grid's nz)");
+    }
+    // count reads planes k0..k1 (checking them as it goes); emit's normals also read k0 - 1 and k1 + 1
+    double largest = 0;
+    if (k0 > 0) largest = detail::scan_samples(grid, k0 - 1, k0 - 1);
+    if (k1 + 1 < grid.nz()) largest = std::max(largest, detail::scan_samples(grid, k1 + 1, k1 + 1));
+    return detail::RangeExtractor<T>(grid, iso, options).count(k0, k1, largest, nullptr);
+}
+
+std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex, std::int64_t first_triangle)
+{
+    std::vector<RangeOffsets> offsets;
+    offsets.reserve(ranges.size());
+    for (std::size_t r = 0; r < ranges.size(); ++r) {
+        if (r > 0 && ranges[r].k0() != ranges[r - 1].k1()) {
+            throw Error(Status::invalid_argument, "scan: range " + std::to_string(r) + " starts at plane " +
+                                                      std::to_string(ranges[r].k0()) + "; expected " +
+                                                      std::to_string(ranges[r - 1].k1()) +
+                                                      ", where the range before it ends");
+        }
+        offsets.push_back({first_vertex, first_triangle});
+        first_vertex += ranges[r].vertex_count();
+        first_triangle += ranges[r].triangle_count();
+    }
+    return offsets;
+}
+
+std::vector<int> emit_order(std::span<const RangeCounts> ranges)
+{
+    std::vector<int> order(ranges.size());
+    std::iota(order.begin(), order.end(), 0);
+    const auto size_of = [ranges](int r) {
+        const RangeCounts& c = ranges[static_cast<std::size_t>(r)];
+        return c.vertex_count() + c.triangle_count();
+    };
+    std::stable_sort(order.begin(), order.end(), [&size_of](int a, int b) { return size_of(a) > size_of(b); });
+    return order;
+}
+
+template <class T>
+void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
+          const RangeOffsets& offsets, const MeshSpans& out)
+{
+    check_passes_method(options, "emit");
+    detail::check_grid(grid, iso);
+    if (counts.k1() > grid.nz() || counts.k0() >= counts.k1() || !detail::RangeExtractor<T>::same_rows(counts, grid)) {
+        throw Error(Status::invalid_argument, "emit: the counts of planes " + range_text(counts.k0(), counts.k1()) +
+                                                  " are not of this grid (" + std::to_string(grid.nx()) + "x" +
+                                                  std::to_string(grid.ny()) + "x" + std::to_string(grid.nz()) +
+                                                  "); expected counts from count() on the same grid");
+    }
+    detail::RangeExtractor<T>(grid, iso, options).emit(counts, offsets, out, nullptr);
+}
+
+#define CMC33_INSTANTIATE(T)                                                                                    \
+    template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
+    template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
+                          const MeshSpans&);
+CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
+#undef CMC33_INSTANTIATE
+
+} // namespace cmc33
