@@ -40,7 +40,7 @@ for flag in "$@"; do
         ;;
     --python) packages+=(python3-dev pybind11-dev python3-pybind11 python3-numpy python3-setuptools python3-wheel
                          python3-venv python3-pip python3-build python3-pytest python3-skimage python3-meshio
-                         python3-vtk9) ;;
+                         python3-vtk9 python3-dask python3-distributed python3-zarr) ;;
     --paper) packages+=(python3-matplotlib python3-numpy python3-vtk9 xvfb xauth) ;;
     *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --paper, --python or --web" >&2; exit 2 ;;
     esac
