@@ -1,12 +1,15 @@
 #!/usr/bin/env bash
 # Installs the Debian packages cmc33 needs to build and test, and nothing else.
 # Idempotent and quiet when everything is present.
-# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--paper] [--python] [--web]
+# Usage: scripts/install-deps.sh [--bench] [--fuzz] [--mpi] [--paper] [--paraview] [--python] [--web]
 #   --bench   also the peers the benchmark compares against (VTK, scikit-image)
 #   --fuzz    also clang and its libFuzzer/sanitizer runtimes (scripts/fuzz.sh)
 #   --mpi     also Open MPI, for cmc33-mpi and its tests (scripts/test-mpi.sh)
 #   --paper   also what scripts/paper/all.sh needs for the paper's figures (matplotlib, VTK, and
 #             xvfb: Debian's VTK renders off screen only through an X server)
+#   --paraview also ParaView with its Python (pvbatch), for the plugin's test (tests/paraview; about
+#             600 MB installed, so only scripts/test-python.sh asks for it). python3-paraview ships
+#             VTK's Python modules itself and conflicts with python3-vtk9, which it then stands for.
 #   --python  also what the Python package needs to build, test and show its examples (python/,
 #             scripts/test-python.sh): pybind11, numpy, setuptools, venv, build, pytest, and the
 #             peers its tests and README use (scikit-image, meshio, VTK)
@@ -31,6 +34,7 @@ for flag in "$@"; do
     --bench) packages+=(libbenchmark-dev python3-vtk9 python3-skimage python3-numpy time) ;;
     --fuzz) packages+=(clang libclang-rt-14-dev) ;;
     --mpi) packages+=(libopenmpi-dev openmpi-bin) ;;
+    --paraview) packages+=(paraview python3-paraview) ;;
     --web)
         # node-acorn: emscripten's optimizer requires it. node and npm only where there are none
         # (a node from elsewhere, with its own npm, is kept).
@@ -42,12 +46,15 @@ for flag in "$@"; do
                          python3-venv python3-pip python3-build python3-pytest python3-skimage python3-meshio
                          python3-vtk9 python3-dask python3-distributed python3-zarr) ;;
     --paper) packages+=(python3-matplotlib python3-numpy python3-vtk9 xvfb xauth) ;;
-    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --paper, --python or --web" >&2; exit 2 ;;
+    *) echo "install-deps: unknown option \"$flag\"; expected --bench, --fuzz, --mpi, --paper, --paraview, --python or --web" >&2; exit 2 ;;
     esac
 done
 
 missing=()
+installed() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
 for p in "${packages[@]}"; do
+    # python3-paraview's vtkmodules stand for python3-vtk9's (installing both removes one)
+    [[ $p == python3-vtk9 ]] && { [[ " ${packages[*]} " == *" python3-paraview "* ]] || installed python3-paraview; } && continue
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
 [[ ${#missing[@]} -eq 0 ]] && exit 0
