@@ -7,7 +7,7 @@
 # CMake tree pip and the wheel share). Usage: scripts/test-python.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh --python
+scripts/install-deps.sh --python --paraview
 export CMAKE_BUILD_PARALLEL_LEVEL=${CMAKE_BUILD_PARALLEL_LEVEL:-2}
 export CMC33_CMAKE_ARGS="-DCMC33_WERROR=ON ${CMC33_CMAKE_ARGS:-}"
 work=build-python
@@ -34,3 +34,9 @@ print("wheel:", cmc33.__file__)')
 
 echo "== pytest"
 CMC33_CLI="$PWD/build/cli/cmc33" "$work/venv/bin/python" -m pytest -q -p no:cacheprovider python/tests
+
+echo "== cmc33.vtk and the ParaView plugin in pvbatch (tests/paraview; exit 77: skipped), on the wheel's package"
+for test in test_vtk_filter.py "test_pvbatch.py --cmc33 build/cli/cmc33 --volume ../shared/data/volumes/aneurism_256x256x256_uint8.nrrd"; do
+    # shellcheck disable=SC2086
+    "$work/wheel-venv/bin/python" tests/paraview/$test || [[ $? -eq 77 ]]
+done
