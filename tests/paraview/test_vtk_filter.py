@@ -137,6 +137,12 @@ def main():
     ok &= check("field data: two tuples, method mc", poly.GetFieldData().GetArray("cmc33_euler").GetNumberOfTuples() == 2
                 and poly.GetFieldData().GetAbstractArray("cmc33_method").GetValue(0) == "mc")
 
+    # no isovalue (ParaView's Isosurfaces can be empty): an empty output, as vtkContourFilter's
+    f.SetIsovalues([])
+    f.Update()
+    ok &= check("no isovalue: an empty output", f.GetOutput().GetNumberOfCells() == 0
+                and f.GetOutput().GetFieldData().GetArray("cmc33_euler").GetNumberOfTuples() == 0)
+
     # bad input: a one-line error naming what is wrong
     vector = image_of(samples, (1, 1, 1), (0, 0, 0), np.eye(3), (0, 0, 0))
     try:

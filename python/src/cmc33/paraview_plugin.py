@@ -19,7 +19,7 @@ try:
     import cmc33.vtk as _cmc33_vtk
 except ImportError:
     # loaded by path from an installed package that ParaView's sys.path does not list
-    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+    sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.realpath(__file__))))
     import cmc33.vtk as _cmc33_vtk
 
 from paraview.util.vtkAlgorithm import smdomain, smhint, smproperty, smproxy
@@ -50,9 +50,9 @@ class CMC33Isosurface(_cmc33_vtk.ExtractFilter):
     def SetInputArrayToProcess(self, *args):
         return _cmc33_vtk.ExtractFilter.SetInputArrayToProcess(self, *args)
 
-    @smproperty.doublevector(name="Isovalues", label="Isosurfaces", command="SetIsovalueAt", number_of_elements=1,
-                             default_values=0.0, repeat_command=1, number_of_elements_per_command=1,
-                             use_index=1, set_number_command="SetNumberOfIsovalues")
+    @smproperty.doublevector(name="Isovalues", label="Isosurfaces", command="SetIsovalueAt", number_of_elements=0,
+                             repeat_command=1, number_of_elements_per_command=1, use_index=1,
+                             set_number_command="SetNumberOfIsovalues")
     @smdomain.xml("""
         <ArrayRangeDomain name="scalar_range" default_mode="mid">
           <RequiredProperties>

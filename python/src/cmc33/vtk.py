@@ -225,10 +225,8 @@ class ExtractFilter(VTKPythonAlgorithmBase):
         self.SetIsovalues([value])
 
     def SetIsovalues(self, values: Sequence[float]) -> None:
-        """The isovalues, one mesh each, in order."""
+        """The isovalues, one mesh each, in order (none: an empty output)."""
         values = [float(v) for v in values]
-        if not values:
-            raise ValueError("no isovalue; expected at least one")
         if values != self._isovalues:
             self._isovalues = values
             self.Modified()
@@ -331,7 +329,10 @@ class ExtractFilter(VTKPythonAlgorithmBase):
             meshes.append(_api.extract(samples, iso, **frame, method=self._method, normals=self._normals,
                                        threads=self._threads, progress=progress))
 
-        whole = meshes[0] if count == 1 else _append(meshes, self._normals)
+        if count == 0:  # as vtkContourFilter without values: an empty output
+            whole = Mesh(np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32))
+        else:
+            whole = meshes[0] if count == 1 else _append(meshes, self._normals)
         values = np.repeat(np.array(self._isovalues, dtype=np.float64), [m.vertex_count for m in meshes])
         output.ShallowCopy(mesh_to_polydata(whole, scalars=values, scalars_name=name))
 
