@@ -5,20 +5,19 @@ data's topology. Arguments: VOLUME ISOVALUE."""
 import json
 import sys
 
-from paraview import servermanager
-from paraview.simple import CreateWriter, OpenDataFile  # noqa: F401
+from paraview import servermanager, simple
 
 import cmc33.vtk
 
 volume, iso = sys.argv[1], float(sys.argv[2])
-cmc33.vtk.load_paraview_plugin(globals())
-reader = OpenDataFile(volume)
+cmc33.vtk.load_paraview_plugin()  # the filter joins paraview.simple
+reader = simple.OpenDataFile(volume)
 if reader is None:
     sys.exit(f"{volume}: ParaView has no reader for this file")
 reader.UpdatePipeline()
 array = reader.PointData.keys()[0]
-surface = CMC33Isosurface(Input=reader, ContourBy=["POINTS", array], Isosurfaces=[iso],  # noqa: F821
-                          ComputeNormals=0, Threads=2)
+surface = simple.CMC33Isosurface(Input=reader, ContourBy=["POINTS", array], Isosurfaces=[iso],
+                                 ComputeNormals=0, Threads=2)
 mesh = servermanager.Fetch(surface)
 fields = mesh.GetFieldData()
 print(json.dumps({

@@ -67,7 +67,7 @@ def main():
     args = package_path.arguments(__doc__).parse_args()
     package_path.setup(args)
     try:
-        import vtkmodules.vtkCommonDataModel  # noqa: F401
+        import vtkmodules.vtkCommonDataModel  # noqa: F401 - is VTK there?
     except ImportError as e:
         package_path.skip(f"VTK's Python bindings are not installed ({e}; Debian: python3-vtk9)")
     import cmc33

@@ -32,9 +32,9 @@ except ImportError as e:  # pragma: no cover - depends on the environment
     raise ImportError(f"cmc33.vtk needs VTK's Python bindings (Debian: python3-vtk9; pip: vtk): {e}") from e
 
 from . import _api
-from ._api import METHODS
+from ._api import METHODS  # noqa: F401 - the plugin's Method choices
 from ._cmc33 import Mesh, Volume
-from ._cmc33 import version as __version__
+from ._cmc33 import version as __version__  # noqa: F401 - the plugin's version
 
 __all__ = ["ExtractFilter", "image_to_samples", "samples_to_image", "mesh_to_polydata", "topology_arrays",
            "PARAVIEW_PLUGIN", "load_paraview_plugin"]
