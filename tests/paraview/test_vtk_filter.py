@@ -153,6 +153,21 @@ def main():
         ok &= check("a 3-component array is refused", False)
     except ValueError as e:
         ok &= check("a 3-component array is refused", "3 components" in str(e), str(e))
+
+    # an input error fails the request in one line, as VTK's filters do, and leaves no output
+    nan = image_of(samples, (1, 1, 1), (0, 0, 0), np.eye(3), (0, 0, 0))
+    nan.GetPointData().GetScalars().SetValue(7, float("nan"))
+    f = ExtractFilter()
+    f.SetInputData(nan)
+    f.SetIsovalue(iso)
+    f.Update()
+    error = f.GetLastError() or ""
+    ok &= check("NaN samples: an empty output and one line", f.GetOutput().GetNumberOfCells() == 0
+                and "NaN" in error and "\n" not in error, error)
+    f.SetInputData(image_of(samples, (1, 1, 1), (0, 0, 0), np.eye(3), (0, 0, 0)))
+    f.Update()
+    ok &= check("then a good input: the mesh, no error", f.GetOutput().GetNumberOfCells() == reference.triangle_count
+                and f.GetLastError() is None)
     return 0 if ok else 1
 
 

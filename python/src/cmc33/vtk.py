@@ -26,15 +26,17 @@ import numpy as np
 try:  # vtkmodules is VTK's own package, in ParaView's Python as well
     from vtkmodules.util import numpy_support
     from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
-    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkPoints, vtkStringArray
+    from vtkmodules.vtkCommonCore import vtkDoubleArray, vtkIntArray, vtkOutputWindow, vtkPoints, vtkStringArray
     from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkDataObject, vtkImageData, vtkPolyData
 except ImportError as e:  # pragma: no cover - depends on the environment
     raise ImportError(f"cmc33.vtk needs VTK's Python bindings (Debian: python3-vtk9; pip: vtk): {e}") from e
 
 from . import _api
 from ._api import METHODS  # noqa: F401 - the plugin's Method choices
+from ._arrays import thread_count
 from ._cmc33 import Mesh, Volume
 from ._cmc33 import version as __version__  # noqa: F401 - the plugin's version
+from ._errors import Error
 
 __all__ = ["ExtractFilter", "image_to_samples", "samples_to_image", "mesh_to_polydata", "topology_arrays",
            "PARAVIEW_PLUGIN", "load_paraview_plugin"]
@@ -197,8 +199,9 @@ class ExtractFilter(VTKPythonAlgorithmBase):
     isovalue: ``cmc33_isovalues``, ``cmc33_euler``, ``cmc33_betti``, ``cmc33_manifold``, ... and
     ``cmc33_embedded`` (see :func:`topology_arrays`), and ``cmc33_method`` names the method.
 
-    Errors (no scalars, bad options, NaN samples) are raised from Update() as cmc33's exceptions
-    through VTK, which reports the failed request.
+    Errors of the input (no scalars, several components, NaN samples) fail the request as VTK's
+    filters do: a one-line message on VTK's output window (ParaView's Output Messages), an empty
+    output, and the message in GetLastError(). Bad options raise at once from the Set methods.
     """
 
     def __init__(self) -> None:
@@ -210,6 +213,7 @@ class ExtractFilter(VTKPythonAlgorithmBase):
         self._topology = True
         self._embedding = True
         self._threads = 0
+        self._error: Optional[str] = None
 
     def SetInputData(self, image: Any) -> None:
         """The input image, without a pipeline (as vtkImageAlgorithm's SetInputData)."""
@@ -297,7 +301,6 @@ class ExtractFilter(VTKPythonAlgorithmBase):
 
     def SetThreads(self, threads: int) -> None:
         """Worker threads, 0 (default) for every core; the mesh is the same for every count."""
-        from ._arrays import thread_count
         self._set("_threads", thread_count(threads))
 
     def GetThreads(self) -> int:
@@ -314,11 +317,28 @@ class ExtractFilter(VTKPythonAlgorithmBase):
                              "cmc33 extracts from point (sample) values")
         return info.Get(vtkDataObject.FIELD_NAME())
 
+    def GetLastError(self) -> Optional[str]:
+        """The one-line message of the last Update()'s error, None when it succeeded."""
+        return self._error
+
     def RequestData(self, request: Any, inInfo: Any, outInfo: Any) -> int:
+        # VTK does not pass a filter's exception to Update()'s caller: report it in one line as
+        # VTK's own filters do, keep it for GetLastError(), and fail the request
+        self._error = None
+        try:
+            return self._request_data(inInfo, outInfo)
+        except (Error, ValueError, MemoryError) as e:
+            self._error = f"cmc33.vtk.ExtractFilter: {e}"
+            vtkOutputWindow.GetInstance().DisplayErrorText(self._error + "\n")
+            vtkPolyData.GetData(outInfo).Initialize()
+            return 0
+
+    def _request_data(self, inInfo: Any, outInfo: Any) -> int:
         image = vtkImageData.GetData(inInfo[0])
         output = vtkPolyData.GetData(outInfo)
-        samples, frame = image_to_samples(image, self._array_name(image))
-        name = self._array_name(image) or image.GetPointData().GetScalars().GetName() or "isovalue"
+        chosen = self._array_name(image)
+        samples, frame = image_to_samples(image, chosen)
+        name = chosen or image.GetPointData().GetScalars().GetName() or "isovalue"
         count = len(self._isovalues)
 
         meshes = []
