@@ -623,6 +623,9 @@ VerifyReport verify_py(const std::vector<std::string>& methods, std::int64_t cel
 }
 
 } // namespace
+
+void bind_blocks(py::module_& m); // blocks.cpp: cmc33.dask's per-block extraction
+
 } // namespace cmc33::python
 
 PYBIND11_MODULE(_cmc33, m)
@@ -637,6 +640,7 @@ PYBIND11_MODULE(_cmc33, m)
     bind_volumes(m);
     bind_topology(m);
     bind_verify(m);
+    bind_blocks(m);
 
     m.attr("version") = std::string(CMC33_VERSION_STRING);
     m.def("method_names", [] {
