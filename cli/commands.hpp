@@ -15,10 +15,11 @@ void add_verify(CLI::App& app);
 void add_dataset(CLI::App& app);
 void add_sweep(CLI::App& app);
 void add_simplify(CLI::App& app);
+void add_labels(CLI::App& app);
 
 using AddCommand = void (*)(CLI::App&);
 
 /// Every command, in the order `cmc33 --help` lists them.
-inline constexpr AddCommand kCommands[] = {add_extract, add_info, add_topo, add_cell, add_verify, add_dataset, add_sweep, add_simplify};
+inline constexpr AddCommand kCommands[] = {add_extract, add_info, add_topo, add_cell, add_verify, add_dataset, add_sweep, add_simplify, add_labels};
 
 } // namespace cmc33::cli

@@ -4,6 +4,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/io.hpp"
+#include "cmc33/labels.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/mesh_ops.hpp"
 #include "cmc33/topology.hpp"
