@@ -1,0 +1,190 @@
+// cmc33 labels: the surfaces of every label of a segmentation, as a partition whose interfaces are
+// shared (src/labels, docs/labels.md): a folder of one closed surface per label, or one PLY of
+// interface triangles with the labels on their two sides.
+
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <string>
+
+#include "atomic_file.hpp"
+#include "cmc33/error.hpp"
+#include "cmc33/io.hpp"
+#include "cmc33/labels.hpp"
+#include "cmc33/topology.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "plural.hpp"
+
+namespace cmc33::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct LabelsArgs {
+    std::string input, output;
+    std::string labels = "all";
+    std::int64_t background = 0;
+    std::string format = "ply";
+    bool json = false;
+    int threads = 0;
+    RawVolumeOptions raw;
+};
+
+bool ends_with(const std::string& s, const std::string& tail)
+{
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// Binary little-endian PLY of the interfaces with `front` and `behind` face properties (int, or
+// uint for labels past int32's range).
+void write_interfaces_ply(const LabelSurfaces& s, const std::string& path)
+{
+    bool fits_int = true;
+    for (const std::int64_t l : s.present) {
+        fits_int = fits_int && l >= std::numeric_limits<std::int32_t>::min() && l <= std::numeric_limits<std::int32_t>::max();
+    }
+    const Mesh& m = s.interfaces;
+    io::detail::write_atomically(path, [&](std::ostream& out) {
+        const char* type = fits_int ? "int" : "uint";
+        out << "ply\nformat binary_little_endian 1.0\ncomment cmc33 labels: interface triangles; the normal (counter-"
+               "clockwise winding) points into label `front`\nelement vertex "
+            << m.vertex_count() << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
+            << m.triangle_count() << "\nproperty list uchar int vertex_indices\nproperty " << type << " front\nproperty "
+            << type << " behind\nend_header\n";
+        // little-endian hosts only (as the library's PLY writer): bytes as they are in memory
+        out.write(reinterpret_cast<const char*>(m.positions.data()), static_cast<std::streamsize>(m.positions.size() * 4));
+        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+            char face[1 + 12 + 8];
+            face[0] = 3;
+            std::memcpy(face + 1, &m.triangles[3 * t], 12);
+            const auto f = static_cast<std::uint32_t>(s.front[t]), b = static_cast<std::uint32_t>(s.behind[t]);
+            std::memcpy(face + 13, &f, 4);
+            std::memcpy(face + 17, &b, 4);
+            out.write(face, sizeof face);
+        }
+    });
+}
+
+void run_labels(const LabelsArgs& args)
+{
+    LabelOptions options;
+    options.background = args.background;
+    try {
+        options.labels = parse_label_ranges(args.labels);
+    } catch (const Error& e) {
+        throw UsageError(std::string("--") + e.what());
+    }
+    const bool single = ends_with(args.output, ".ply") && !fs::is_directory(args.output);
+    if (ends_with(args.output, ".glb") || ends_with(args.output, ".gltf")) {
+        throw UsageError("-o " + args.output + ": one glTF scene of all labels is not written yet; give a folder (one file "
+                         "per label, --format glb) or a .ply of the interfaces");
+    }
+    if (single) {
+        check_mesh_output(args.output, false, false, {args.input});
+    } else {
+        // a folder: made if missing (its parent must exist); every file is named label_<value>.<format>
+        check_mesh_output((fs::path(args.output) / ("label_0." + args.format)).string(), false, false, {args.input});
+    }
+    const Volume volume = load_volume(args.input, args.raw);
+    const LabelSurfaces s = named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
+
+    Json labels = Json::array();
+    if (single) {
+        named_step(args.output, "writing the interfaces", [&] { write_interfaces_ply(s, args.output); });
+    } else {
+        std::error_code ec;
+        fs::create_directory(args.output, ec);
+        if (ec) throw Error(Status::io_error, args.output + ": cannot make the folder (" + ec.message() + ")");
+    }
+    MeshGeometryOptions geometry_options;
+    geometry_options.threads = args.threads;
+    for (const std::int64_t value : s.selected) {
+        const Mesh m = label_surface(s, value);
+        std::string file;
+        if (!single) {
+            file = (fs::path(args.output) / ("label_" + std::to_string(value) + "." + args.format)).string();
+            io::MeshWriteOptions wo;
+            wo.space = volume.space();
+            named_step(file, "writing a label's surface", [&] { io::write_mesh(m, file, wo); });
+        }
+        if (args.json) {
+            const MeshTopology t = mesh_topology(m);
+            const MeshGeometry g = mesh_geometry(m, geometry_options);
+            labels.push_back(Json{{"value", value},
+                                  {"file", file.empty() ? Json(nullptr) : Json(file)},
+                                  {"vertices", static_cast<std::int64_t>(m.vertex_count())},
+                                  {"triangles", static_cast<std::int64_t>(m.triangle_count())},
+                                  {"topology", topology_json(t)},
+                                  {"embedded", g.embedded()},
+                                  {"geometry", geometry_json(g)}});
+        }
+    }
+    if (args.json) {
+        Json present = Json::array();
+        for (const std::int64_t v : s.present) present.push_back(v);
+        print_json(Json{{"volume", volume_json(args.input, volume)},
+                        {"output", args.output},
+                        {"background", args.background},
+                        {"present", present},
+                        {"interface_triangles", static_cast<std::int64_t>(s.interfaces.triangle_count())},
+                        {"cells_two_labels", s.cells_two_labels},
+                        {"cells_many_labels", s.cells_many_labels},
+                        {"labels", labels}});
+        return;
+    }
+    std::cout << args.input << ": " << counted(static_cast<std::int64_t>(s.present.size()), "label") << " present, "
+              << counted(static_cast<std::int64_t>(s.selected.size()), "surface") << ", "
+              << counted(static_cast<std::int64_t>(s.interfaces.triangle_count()), "interface triangle") << " -> "
+              << args.output << "\n";
+}
+
+} // namespace
+
+void add_labels(CLI::App& app)
+{
+    auto args = std::make_shared<LabelsArgs>();
+    CLI::App* cmd = app.add_subcommand("labels", "Surfaces of every label of a label map, sharing their interfaces");
+    cmd->add_option("VOLUME", args->input, "Label map: integer samples (.nrrd .nii .mha .vtk .npy .vti .tif, or raw)")
+        ->required()
+        ->check(non_empty("a volume file"));
+    cmd->add_option("-o,--output", args->output,
+                    "A folder (one file per label, label_<value>.<format>; made if missing) or a .ply of the "
+                    "interface triangles with face properties front and behind")
+        ->required()
+        ->type_name("OUT")
+        ->check(non_empty("an output folder or .ply file"));
+    cmd->add_option("--labels", args->labels, "Labels that get surfaces: all (default), a list 1,3,7, ranges 2-9")
+        ->type_name("LIST");
+    cmd->add_option("--background", args->background, "The label without a surface (default 0); it still takes part")
+        ->type_name("VALUE")
+        ->check(whole_number(std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()));
+    cmd->add_option("--format", args->format, "Format of a folder's files: ply (default), obj, stl, off, glb, gltf, vtp, gii")
+        ->type_name("EXT")
+        ->check(CLI::IsMember({"ply", "obj", "stl", "off", "glb", "gltf", "vtp", "gii"}));
+    cmd->add_flag("--json", args->json, "Print one JSON object: every label's file, size, topology and embedding");
+    cmd->add_option("--threads", args->threads, "Worker threads of the --json checks, 0 = all cores (the surfaces: one)")
+        ->type_name("N")
+        ->check(thread_count());
+    add_raw_volume_options(*cmd, args->raw);
+    cmd->footer(
+        "Every point of the volume's box belongs to one label: the one whose indicator's trilinear\n"
+        "interpolant is largest there, ties to the lower label. Where two labels meet in a cell their\n"
+        "interface is cmc33's triangulation of the level set 0.5 of the lower label's indicator; cells\n"
+        "with three or more labels are cut by cones from the cell's centre (docs/labels.md). Each\n"
+        "label's surface is closed except on the volume's box, oriented outward and embedded, and\n"
+        "neighbouring labels share their interface triangles exactly.\n"
+        "\n"
+        "Examples:\n"
+        "  cmc33 labels seg.nrrd -o meshes/ --json\n"
+        "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
+        "  cmc33 labels seg.nrrd -o interfaces.ply");
+    cmd->callback([args] { run_labels(*args); });
+}
+
+} // namespace cmc33::cli

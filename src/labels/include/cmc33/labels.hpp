@@ -1,0 +1,61 @@
+#pragma once
+/// @file labels.hpp
+/// Label maps: the surfaces of every label of a segmentation from one pass, as a partition of
+/// space whose interfaces are shared (docs/labels.md).
+///
+/// Labels are integers at the samples. A label's region is where its indicator's trilinear
+/// interpolant is largest, ties to the lower label. In a cell holding two labels a < b that is the
+/// level set 0.5 of a's indicator, triangulated with cmc33's own decisions (a's corners above); a
+/// cell holding three or more labels is cut by cones from its centre over its faces' curves.
+/// Each interface triangle is emitted once with the label in front (the side its normal points
+/// to) and the label behind; a label's closed surface is the triangles that have it on a side.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "cmc33/mesh.hpp"
+#include "cmc33/volume.hpp"
+#include "cmc33/labels_export.hpp"
+
+namespace cmc33 {
+
+/// Inclusive ranges of label values ({v, v} for one value).
+using LabelRanges = std::vector<std::array<std::int64_t, 2>>;
+
+/// "all" (empty ranges), or a comma-separated list of values and ranges "1,3,7", "2-9", "-5--1".
+/// @throws Error{invalid_argument} naming the text and what was expected.
+CMC33_LABELS_EXPORT LabelRanges parse_label_ranges(std::string_view text);
+
+struct LabelOptions {
+    /// The label that gets no surface (it still takes part in the partition).
+    std::int64_t background = 0;
+    /// The labels that get surfaces; empty: every label present except `background`.
+    LabelRanges labels{};
+};
+
+/// The interfaces of a label map, in world coordinates as extract() places vertices (the volume's
+/// origin, spacing and direction).
+struct LabelSurfaces {
+    /// Every interface triangle that has a selected label on a side, once. Its normal (counter-
+    /// clockwise winding) points into `front`. Vertices are shared: welded by grid position.
+    Mesh interfaces;
+    std::vector<std::int64_t> front, behind; ///< one label per triangle of `interfaces`
+    std::vector<std::int64_t> present;       ///< every label value in the volume, ascending
+    std::vector<std::int64_t> selected;      ///< the labels that get surfaces, ascending
+    std::int64_t cells_two_labels = 0;       ///< cells with exactly two labels (cmc33's triangulation)
+    std::int64_t cells_many_labels = 0;      ///< cells with three or more (the centre construction)
+};
+
+/// One pass over `labels` (an integer sample type).
+/// @throws Error{unsupported_format} for float or double samples; Error{too_large} past 2^32 vertices.
+CMC33_LABELS_EXPORT LabelSurfaces label_surfaces(const Volume& labels, const LabelOptions& options = {});
+
+/// The closed surface of `label` (closed except where it meets the volume's box): the interface
+/// triangles with `label` on a side, wound so that normals point out of the label's region,
+/// with only the vertices they use. Empty for a label that is not in `selected`.
+CMC33_LABELS_EXPORT Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label);
+
+} // namespace cmc33

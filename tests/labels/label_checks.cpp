@@ -1,0 +1,202 @@
+// The checks of label_checks.hpp, made from the mesh alone and from the samples alone: nothing here
+// uses the label extractor's tables.
+
+#include "label_checks.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <random>
+#include <set>
+
+#include "cmc33/extract.hpp"
+#include "cmc33/topology.hpp"
+
+namespace cmc33::label_checks {
+
+namespace {
+
+using Point = std::array<float, 3>;
+using Tri = std::array<Point, 3>;
+
+Point point(const Mesh& m, std::uint32_t v) { return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]}; }
+
+// The oriented triangle, rotated so that its smallest corner comes first.
+Tri oriented(const Mesh& m, std::size_t t)
+{
+    Tri tri{point(m, m.triangles[3 * t]), point(m, m.triangles[3 * t + 1]), point(m, m.triangles[3 * t + 2])};
+    const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
+    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    return tri;
+}
+
+// The triangles as a set, their corners rounded to 1e-5: cmc33's interior points of a cell come
+// from analyze_cell() in floats of the unit cube, one float step from extract()'s.
+std::multiset<Tri> triangle_set(const Mesh& m, bool reverse)
+{
+    std::multiset<Tri> out;
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        Tri tri = oriented(m, t);
+        for (Point& p : tri)
+            for (float& x : p) x = static_cast<float>(std::round(static_cast<double>(x) * 1e5));
+        if (reverse) {
+            std::swap(tri[1], tri[2]);
+        }
+        out.insert(tri);
+    }
+    return out;
+}
+
+// A segment lies in the box's boundary when both ends share a coordinate at 0 or n - 1.
+bool on_box(const Point& a, const Point& b, const Index3& dims)
+{
+    for (std::size_t c = 0; c < 3; ++c) {
+        const float hi = static_cast<float>(dims[c] - 1);
+        if ((a[c] == 0 && b[c] == 0) || (a[c] == hi && b[c] == hi)) return true;
+    }
+    return false;
+}
+
+void fail(Counts& counts, std::int64_t& which, const std::string& what)
+{
+    ++which;
+    if (counts.first_failure.empty()) counts.first_failure = what;
+}
+
+} // namespace
+
+Volume random_labels(std::int64_t n, int labels, std::uint64_t seed, bool smooth)
+{
+    Volume v(ScalarType::i32, {n, n, n});
+    std::int32_t* s = v.samples<std::int32_t>();
+    std::mt19937_64 rng(seed * 0x9E3779B97F4A7C15ULL + static_cast<std::uint64_t>(labels));
+    if (!smooth) {
+        std::uniform_int_distribution<int> pick(1, labels);
+        for (std::int64_t i = 0; i < n * n * n; ++i) s[i] = pick(rng);
+        return v;
+    }
+    // the label of the nearest of a few random seeds per label (a Voronoi-like partition) with noise
+    std::uniform_real_distribution<double> u(0, static_cast<double>(n - 1));
+    std::vector<std::array<double, 4>> seeds;
+    for (int l = 1; l <= labels; ++l)
+        for (int k = 0; k < 3; ++k) seeds.push_back({u(rng), u(rng), u(rng), static_cast<double>(l)});
+    std::uniform_real_distribution<double> noise(0, 1.5);
+    for (std::int64_t z = 0; z < n; ++z)
+        for (std::int64_t y = 0; y < n; ++y)
+            for (std::int64_t x = 0; x < n; ++x) {
+                double best = 1e300;
+                int label = 1;
+                for (const auto& p : seeds) {
+                    const double d = std::hypot(static_cast<double>(x) - p[0], static_cast<double>(y) - p[1],
+                                                static_cast<double>(z) - p[2]) + noise(rng);
+                    if (d < best) {
+                        best = d;
+                        label = static_cast<int>(p[3]);
+                    }
+                }
+                s[x + n * (y + n * z)] = label;
+            }
+    return v;
+}
+
+void check_field(const Volume& volume, Counts& counts, const std::string& name)
+{
+    ++counts.fields;
+    LabelOptions options;
+    options.labels = {{std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()}};
+    const LabelSurfaces s = label_surfaces(volume, options);
+    const Mesh& all = s.interfaces;
+
+    // every interface triangle once: no two with the same corners
+    {
+        std::set<std::array<std::uint32_t, 3>> seen;
+        for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+            std::array<std::uint32_t, 3> k{all.triangles[3 * t], all.triangles[3 * t + 1], all.triangles[3 * t + 2]};
+            std::sort(k.begin(), k.end());
+            if (!seen.insert(k).second || s.front[t] == s.behind[t]) {
+                fail(counts, counts.duplicate_triangles, name + ": triangle " + std::to_string(t) + " repeated");
+                break;
+            }
+        }
+    }
+    // the union welded by position is watertight: at an edge off the box, every label is on a side
+    // of an even number of its triangles (so no label's region leaks through the edge)
+    {
+        std::map<std::pair<Point, Point>, std::map<std::int64_t, int>> edges;
+        for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+            const Tri tri = oriented(all, t);
+            for (std::size_t e = 0; e < 3; ++e) {
+                Point a = tri[e], b = tri[(e + 1) % 3];
+                if (b < a) std::swap(a, b);
+                auto& sides = edges[{a, b}];
+                ++sides[s.front[t]];
+                ++sides[s.behind[t]];
+            }
+        }
+        for (const auto& [edge, sides] : edges) {
+            if (on_box(edge.first, edge.second, volume.dims())) continue;
+            // every label's sides pair up (a label meeting itself along the edge has 4: counted as
+            // not manifold, not as open)
+            const bool ok = std::all_of(sides.begin(), sides.end(), [](const auto& p) { return p.second % 2 == 0; });
+            if (!ok) {
+                fail(counts, counts.union_not_watertight, name + ": the union is open or branched at an interior edge");
+                break;
+            }
+        }
+        if (!mesh_geometry(all).embedded()) fail(counts, counts.union_not_embedded, name + ": the union is not embedded");
+    }
+    // each label's surface
+    for (const std::int64_t label : s.selected) {
+        ++counts.label_surfaces;
+        const Mesh m = label_surface(s, label);
+        const MeshTopology t = mesh_topology(m);
+        const std::string what = name + ", label " + std::to_string(label);
+        if (t.nonmanifold_edges != 0 || t.nonmanifold_vertices != 0) {
+            fail(counts, counts.not_manifold, what + ": " + std::to_string(t.nonmanifold_edges) + " non-manifold edges, " +
+                                                  std::to_string(t.nonmanifold_vertices) + " non-manifold vertices");
+        }
+        if (!t.oriented) fail(counts, counts.not_oriented, what + ": not oriented");
+        // boundary edges only on the box
+        std::map<std::pair<Point, Point>, int> uses;
+        for (std::size_t f = 0; f < m.triangle_count(); ++f) {
+            const Tri tri = oriented(m, f);
+            for (std::size_t e = 0; e < 3; ++e) {
+                Point a = tri[e], b = tri[(e + 1) % 3];
+                if (b < a) std::swap(a, b);
+                ++uses[{a, b}];
+            }
+        }
+        for (const auto& [edge, n] : uses) {
+            if (n == 1 && !on_box(edge.first, edge.second, volume.dims())) {
+                fail(counts, counts.not_closed, what + ": a boundary edge off the box");
+                break;
+            }
+        }
+        if (!mesh_geometry(m).embedded()) fail(counts, counts.not_embedded, what + ": not embedded");
+    }
+    // two labels: each surface is the extraction of the lower label's indicator at 0.5 (the
+    // higher's reversed), and has the field's topology
+    if (s.present.size() == 2) {
+        const std::int64_t low = s.present[0];
+        Volume indicator(ScalarType::f32, volume.dims());
+        const std::int32_t* in = volume.samples<std::int32_t>();
+        float* out = indicator.samples<float>();
+        for (std::int64_t i = 0; i < volume.sample_count(); ++i) out[i] = in[i] == low ? 1.0F : 0.0F;
+        const Mesh expected = extract(indicator, 0.5);
+        const auto want = triangle_set(expected, false);
+        const Mesh m_low = label_surface(s, low), m_high = label_surface(s, s.present[1]);
+        if (triangle_set(m_low, false) != want || triangle_set(m_high, true) != want) {
+
+            fail(counts, counts.two_label_mismatch, name + ": not the extraction of the lower label's indicator");
+        }
+        const FieldTopology f = field_topology(indicator, 0.5);
+        const MeshTopology t = mesh_topology(m_low);
+        if (!f.determined || f.euler != t.euler || f.b0 != t.components || f.b1 != t.b1 || f.b2 != t.closed_components ||
+            f.boundary_loops != t.boundary_loops) {
+            fail(counts, counts.topology_mismatch, name + ": not the field's topology");
+        }
+    }
+}
+
+} // namespace cmc33::label_checks

@@ -1,0 +1,36 @@
+#pragma once
+// The checks of a label map's surfaces (tests/labels), shared by the fast test and the 20,000-field
+// sweep: each returns what failed, empty when all held.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "cmc33/labels.hpp"
+#include "cmc33/volume.hpp"
+
+namespace cmc33::label_checks {
+
+struct Counts {
+    std::int64_t fields = 0;
+    std::int64_t label_surfaces = 0;
+    std::int64_t not_closed = 0;      ///< a boundary edge off the volume's box
+    std::int64_t not_manifold = 0;    ///< a non-manifold edge or vertex
+    std::int64_t not_oriented = 0;
+    std::int64_t not_embedded = 0;    ///< mesh_geometry of the label's surface
+    std::int64_t union_not_watertight = 0;
+    std::int64_t union_not_embedded = 0;
+    std::int64_t duplicate_triangles = 0;
+    std::int64_t two_label_mismatch = 0; ///< two-label field: not the extraction of the indicator
+    std::int64_t topology_mismatch = 0;  ///< two-label field: not field_topology's numbers
+    std::string first_failure;
+};
+
+/// A random label field: `labels` values 1..labels at the samples of an n^3 grid (i.i.d. when
+/// `smooth` is false, else by thresholds of a smooth random function), from `seed`.
+Volume random_labels(std::int64_t n, int labels, std::uint64_t seed, bool smooth);
+
+/// Every check on `volume` (all its labels selected), added to `counts`.
+void check_field(const Volume& volume, Counts& counts, const std::string& name);
+
+} // namespace cmc33::label_checks
