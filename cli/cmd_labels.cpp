@@ -88,8 +88,12 @@ void run_labels(const LabelsArgs& args)
     if (single) {
         check_mesh_output(args.output, false, false, {args.input});
     } else {
-        // a folder: made if missing (its parent must exist); every file is named label_<value>.<format>
-        check_mesh_output((fs::path(args.output) / ("label_0." + args.format)).string(), false, false, {args.input});
+        // a folder, made if missing (its parent must exist); every file is named label_<value>.<format>
+        const fs::path folder(args.output);
+        const bool exists = fs::is_directory(folder);
+        if (!exists && fs::exists(folder)) throw UsageError("-o " + args.output + ": not a folder or a .ply file");
+        const fs::path where = exists ? folder : (folder.parent_path().empty() ? fs::path(".") : folder.parent_path());
+        check_mesh_output((where / ("label_0." + args.format)).string(), false, false, {args.input});
     }
     const Volume volume = load_volume(args.input, args.raw);
     const LabelSurfaces s = named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
