@@ -221,10 +221,16 @@ void check_inflate_bound(std::uint64_t compressed, std::uint64_t declared, const
 
 // ---- InflateStream --------------------------------------------------------------------------
 
+std::size_t InflateStream::block_for(std::uint64_t size) noexcept
+{
+    // a short stream (a small .nii.gz, a header read alone) needs no 1 MiB block
+    return static_cast<std::size_t>(std::clamp<std::uint64_t>(size, 1, kBlock));
+}
+
 #if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
 InflateStream::InflateStream(const ByteInput& input, std::uint64_t offset, std::uint64_t size, std::string label)
-    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_(new unsigned char[kBlock]),
-      z_(new z_stream_s{})
+    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_size_(block_for(size)),
+      block_(new unsigned char[block_size_]), z_(new z_stream_s{})
 {
     // 15 + 32: a 32 KiB window, and a zlib or gzip header recognised automatically.
     const int status = inflateInit2(z_.get(), 15 + 32);
@@ -254,7 +260,7 @@ std::size_t InflateStream::produce(unsigned char* out, std::size_t count)
         }
         if (z_->avail_in == 0) {
             if (fed_ == size_) break;
-            const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - fed_, kBlock));
+            const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - fed_, block_size_));
             in_.read(offset_ + fed_, block_.get(), n);
             z_->next_in = block_.get();
             z_->avail_in = static_cast<uInt>(n);
@@ -289,7 +295,8 @@ std::size_t InflateStream::produce(unsigned char* out, std::size_t count)
 
 #else
 InflateStream::InflateStream(const ByteInput& input, std::uint64_t offset, std::uint64_t size, std::string label)
-    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_(new unsigned char[kBlock])
+    : in_(input), offset_(offset), size_(size), label_(std::move(label)), block_size_(block_for(size)),
+      block_(new unsigned char[block_size_])
 {
     // the portable inflater reads memory: the compressed stream is read whole (a build without
     // zlib, the WebAssembly one, holds its files in memory anyway)
@@ -354,7 +361,7 @@ void InflateStream::finish(std::uint64_t wanted)
     }
     // Only zero padding may follow the stream.
     for (std::uint64_t at = consumed(); at < size_;) {
-        const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - at, kBlock));
+        const std::size_t n = static_cast<std::size_t>(std::min<std::uint64_t>(size_ - at, block_size_));
         in_.read(offset_ + at, block_.get(), n);
         const auto* first = std::find_if(block_.get(), block_.get() + n, [](unsigned char c) { return c != 0; });
         if (first != block_.get() + n) {
@@ -431,10 +438,10 @@ std::unique_ptr<std::byte[]> inflate_exact(std::string_view in, std::uint64_t sk
     InflateStream inflater(input, 0, in.size(), label);
     const std::uint64_t wanted = skip + out_size;
     inflater.skip(skip, wanted);
-    // Real volumes compress a few times; start at 16 times the stream (at least 1 MiB, never
+    // Real volumes compress a few times; start at 16 times the stream (at least 64 KiB, never
     // more than declared) and double while the stream keeps producing.
     constexpr std::size_t kRatioGuess = 16;
-    constexpr std::size_t kMinimum = std::size_t{1} << 20;
+    constexpr std::size_t kMinimum = std::size_t{1} << 16;
     const std::size_t guess = in.size() > std::numeric_limits<std::size_t>::max() / kRatioGuess
                                   ? out_size
                                   : std::max(kMinimum, kRatioGuess * in.size());

@@ -155,11 +155,13 @@ public:
 private:
     [[noreturn]] void fail_short(std::uint64_t wanted) const;
     std::uint64_t consumed() const noexcept;
+    static std::size_t block_for(std::uint64_t size) noexcept;
     static constexpr std::size_t kBlock = std::size_t{1} << 20;
     static constexpr std::size_t kMaxOut = std::size_t{1} << 30; // zlib counts in 32-bit uInt
     const ByteInput& in_;
     std::uint64_t offset_, size_;
     std::string label_;
+    std::size_t block_size_; ///< kBlock, or the whole stream when shorter
     std::unique_ptr<unsigned char[]> block_;
 #if !defined(CMC33_WITH_ZLIB) || CMC33_WITH_ZLIB
     std::unique_ptr<z_stream_s> z_;
