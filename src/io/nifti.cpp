@@ -323,7 +323,27 @@ std::string head_of(const ByteInput& input, bool compressed)
     return head;
 }
 
+/// x.hdr -> x.img; a compressed x.hdr.gz -> x.img.gz, compressed too (as nibabel writes pairs).
+std::string pair_data_name(const std::string& header_name, bool compressed)
+{
+    std::filesystem::path stem = std::filesystem::path(header_name).stem();
+    if (compressed && lower_ascii(stem.extension().string()) == ".hdr") stem = stem.stem();
+    return stem.string() + (compressed ? ".img.gz" : ".img");
+}
+
 } // namespace
+
+std::optional<std::string> nifti_data_file_name(const ByteInput& file)
+{
+    try {
+        const bool compressed = is_compressed(file);
+        bool single = true;
+        if (version_of(head_of(file, compressed), nullptr, &single) == 0 || single) return std::nullopt;
+        return pair_data_name(file.label(), compressed);
+    } catch (const Error&) {
+        return std::nullopt; // not inflatable: no NIfTI header
+    }
+}
 
 Volume read_nifti(const ByteInput& file, const OpenDataFile& open_data, const ReadOptions& options,
                   const ReadSamples& read, bool planes)
@@ -419,12 +439,7 @@ Volume read_nifti(const ByteInput& file, const OpenDataFile& open_data, const Re
     const std::uint64_t start = vox_offset + static_cast<std::uint64_t>(frame) * frame_bytes;
 
     std::unique_ptr<ByteInput> data_file;
-    if (!h.single_file) {
-        // x.hdr -> x.img; a compressed x.hdr.gz -> x.img.gz, compressed too (as nibabel writes pairs)
-        std::filesystem::path stem = std::filesystem::path(label).stem();
-        if (header_compressed && lower_ascii(stem.extension().string()) == ".hdr") stem = stem.stem();
-        data_file = open_data(stem.string() + (header_compressed ? ".img.gz" : ".img"));
-    }
+    if (!h.single_file) data_file = open_data(pair_data_name(label, header_compressed));
     const ByteInput& data = data_file ? *data_file : file;
     // a single file is compressed when its header is, and so is the .img.gz of a compressed pair
     const bool compressed = header_compressed;

@@ -29,7 +29,8 @@ VolumeLayout describe_volume(const std::filesystem::path& given, const std::opti
     }
     // a NIfTI pair named by its .img is read through its header, as read_volume() does
     const std::vector<std::filesystem::path> files = volume_files(given);
-    const bool pair_by_image = lower_extension(given) == ".img" && files.size() == 2;
+    const std::string given_name = lower_ascii(given.filename().string());
+    const bool pair_by_image = (given_name.ends_with(".img") || given_name.ends_with(".img.gz")) && files.size() == 2;
     const std::filesystem::path path = pair_by_image ? files[1] : given;
     const std::string label = path.string();
     const std::string ext = lower_extension(path);

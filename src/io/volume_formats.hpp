@@ -201,6 +201,10 @@ Volume read_raw(const ByteInput& file, const std::optional<RawOptions>& raw, con
 /// converted after reading (scl_slope, 64-bit integers) is refused instead.
 Volume read_nifti(const ByteInput& file, const OpenDataFile& open_data, const ReadOptions& options,
                   const ReadSamples& read = read_samples, bool planes = false);
+/// The data file a NIfTI pair's header `file` names, "<stem>.img" or, for a compressed header
+/// "<stem>.hdr.gz", "<stem>.img.gz" (relative to the header's folder); nullopt for a single-file
+/// NIfTI or anything else. Never throws.
+std::optional<std::string> nifti_data_file_name(const ByteInput& file);
 /// NumPy .npy (npy.cpp); `planes` as for read_nifti.
 Volume read_npy(const ByteInput& file, const ReadOptions& options, const ReadSamples& read = read_samples,
                 bool planes = false);

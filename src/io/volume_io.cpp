@@ -259,18 +259,30 @@ ScalarType parse_type(const std::string& name)
 
 namespace {
 
-/// x.hdr beside x.img when it holds a NIfTI header (a NIfTI pair named by its data file).
+/// x.hdr beside x.img, or x.hdr.gz beside x.img.gz, when it is a NIfTI pair's header naming that
+/// file (a NIfTI pair named by its data file).
 std::optional<std::filesystem::path> nifti_pair_header(const std::filesystem::path& path)
 {
-    if (detail::lower_extension(path) != ".img") return std::nullopt;
-    for (const char* ext : {".hdr", ".HDR"}) {
-        std::filesystem::path header = path;
-        header.replace_extension(ext);
+    const std::string name = path.filename().string();
+    const std::string lower = detail::lower_ascii(name);
+    std::vector<std::string> headers;
+    if (lower.ends_with(".img")) {
+        const std::string stem = name.substr(0, name.size() - 4);
+        headers = {stem + ".hdr", stem + ".HDR"};
+    } else if (lower.ends_with(".img.gz")) {
+        const std::string stem = name.substr(0, name.size() - 7);
+        headers = {stem + ".hdr.gz", stem + ".HDR.gz", stem + ".HDR.GZ"};
+    } else {
+        return std::nullopt;
+    }
+    for (const std::string& candidate : headers) {
+        const std::filesystem::path header = path.parent_path() / candidate;
         std::error_code ec;
         if (!std::filesystem::is_regular_file(header, ec)) continue;
         try {
             const detail::InputFile file(header, header.string());
-            if (detail::sniff_volume_format(file) == VolumeFormat::nifti) return header;
+            const std::optional<std::string> data = detail::nifti_data_file_name(file);
+            if (data && detail::lower_ascii(*data) == lower) return header;
         } catch (const Error&) {
         }
     }
@@ -326,10 +338,20 @@ std::vector<std::filesystem::path> volume_files(const std::filesystem::path& pat
         files.push_back(*header);
         return files;
     }
-    if (ext == ".hdr" || sniffed_format(path) == VolumeFormat::nifti) {
+    if (sniffed_format(path) == VolumeFormat::nifti) {
+        // the data file the reader opens (x.img, or x.img.gz beside a compressed x.hdr.gz)
+        try {
+            const detail::InputFile file(path, path.string());
+            if (const auto data = detail::nifti_data_file_name(file)) files.push_back(detail::resolve_data_file(path, *data));
+        } catch (const Error&) {
+        }
+        return files;
+    }
+    if (ext == ".hdr") {
+        // not (yet) a NIfTI header: the data file it would name
         std::filesystem::path image = path;
         image.replace_extension(".img");
-        if (image != path) files.push_back(image);
+        files.push_back(image);
         return files;
     }
     const bool nrrd = ext == ".nrrd" || ext == ".nhdr";
