@@ -72,7 +72,7 @@ def main():
         package_path.skip(f"VTK's Python bindings are not installed ({e}; Debian: python3-vtk9)")
     import cmc33
     from vtkmodules.util import numpy_support
-    from cmc33.vtk import ExtractFilter, image_to_samples
+    from cmc33.vtk import ExtractFilter, image_to_samples, samples_to_image
 
     ok = True
     samples = field((19, 23, 29), seed=7)
@@ -118,6 +118,21 @@ def main():
     view, frame = image_to_samples(image)
     image.GetPointData().GetScalars().SetValue(5, 42.0)
     ok &= check("image_to_samples is a view of VTK's memory", view.reshape(-1)[5] == 42.0 and view.shape == samples.shape)
+
+    # a cmc33.Volume to vtkImageData and back: the same samples and frame, the same mesh
+    volume = cmc33.Volume(samples, (0.6, 0.8, 1.4), (1.0, 2.0, -3.0), rotation((2, -1, 1), 0.9))
+    back, frame = image_to_samples(samples_to_image(volume))
+    ok &= check("Volume -> vtkImageData -> samples and frame", np.array_equal(back, samples)
+                and np.allclose(frame["spacing"], volume.spacing) and np.allclose(frame["origin"], volume.origin)
+                and np.allclose(frame["direction"], volume.direction))
+    f = ExtractFilter()
+    f.SetInputData(samples_to_image(volume))
+    f.SetIsovalue(iso)
+    f.Update()
+    points, triangles = polydata_arrays(f.GetOutput())
+    world = cmc33.extract(volume, iso)
+    ok &= check("the filter on it: cmc33.extract(volume)'s vertices and triangles",
+                np.allclose(points, world.vertices, atol=1e-5) and np.array_equal(triangles, world.triangles))
 
     # several isovalues, normals, a named input array
     f = ExtractFilter()
