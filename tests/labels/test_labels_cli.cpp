@@ -1,0 +1,69 @@
+// `cmc33 labels` run as a program: the folder and interface outputs against the library, the same
+// bytes twice, and bad input refused with one line and nothing written.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <sys/wait.h>
+
+#include "cmc33/io.hpp"
+#include "cmc33/labels.hpp"
+#include "cmc33/topology.hpp"
+#include "label_checks.hpp"
+#include "test_support.hpp"
+
+namespace {
+
+using namespace cmc33;
+namespace fs = std::filesystem;
+
+// Exit status of `cmc33 ARGS`, stderr into `err`.
+int run(const std::string& args, const fs::path& err)
+{
+    const std::string command = std::string(CMC33_EXE) + " " + args + " >/dev/null 2>" + err.string();
+    const int status = std::system(command.c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(LabelsCli, FolderAndInterfaces)
+{
+    const fs::path dir = test::temp_dir();
+    const Volume seg = label_checks::random_labels(8, 4, 5, true);
+    io::write_volume(seg, dir / "seg.nrrd");
+    const LabelSurfaces s = label_surfaces(seg);
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --background 2", dir / "err"), 0)
+        << test::read_file(dir / "err");
+    for (const std::int64_t l : {1, 3, 4}) {
+        const Mesh m = io::read_mesh(dir / "out" / ("label_" + std::to_string(l) + ".ply"));
+        const Mesh want = label_surface(s, l);
+        EXPECT_EQ(m.triangle_count(), want.triangle_count());
+        EXPECT_EQ(mesh_topology(m).euler, mesh_topology(want).euler);
+    }
+    EXPECT_FALSE(fs::exists(dir / "out" / "label_2.ply"));
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "i.ply").string(), dir / "err"), 0);
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "j.ply").string(), dir / "err"), 0);
+    const std::string a = test::read_file(dir / "i.ply");
+    EXPECT_EQ(a, test::read_file(dir / "j.ply"));
+    EXPECT_NE(a.find("property int front"), std::string::npos);
+    EXPECT_EQ(io::read_mesh(dir / "i.ply").triangle_count(), s.interfaces.triangle_count());
+}
+
+TEST(LabelsCli, BadInput)
+{
+    const fs::path dir = test::temp_dir();
+    io::write_volume(Volume(ScalarType::f32, {4, 4, 4}), dir / "f.nrrd");
+    EXPECT_NE(run("labels " + (dir / "f.nrrd").string() + " -o " + (dir / "out").string(), dir / "err"), 0);
+    const std::string err = test::read_file(dir / "err");
+    EXPECT_NE(err.find("integer samples"), std::string::npos) << err;
+    EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
+    EXPECT_FALSE(fs::exists(dir / "out"));
+    io::write_volume(Volume(ScalarType::u8, {4, 4, 4}), dir / "u.nrrd");
+    EXPECT_EQ(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o2").string() + " --labels 5-1", dir / "err"), 2);
+    EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "none" / "o3").string(), dir / "err"), 0);
+    EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o.glb").string(), dir / "err"), 0);
+    EXPECT_FALSE(fs::exists(dir / "o.glb"));
+}
+
+} // namespace
