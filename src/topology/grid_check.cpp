@@ -6,6 +6,14 @@
 // order and tests every pair of the cell, and of the cell with its 13 neighbours that come after
 // it (the next cell of the row, three of the next row, nine of the next layer), whose boxes meet.
 // Results are kept per block and summed in block order: the same numbers for any thread count.
+//
+// In an axis-aligned frame most pairs of neighbouring cells are settled without a predicate. When
+// both triangles lie in their cells' closed boxes (checked on the floats), they can meet only where
+// the boxes do, in the contact (a face, an edge or a corner); and a triangle that lies on one side
+// of a plane meets it in the convex hull of its corners on that plane. So each meets the contact in
+// the hull of its corners that lie on it exactly (its trace): if a trace is empty the pair is
+// disjoint, and if one trace is a subset of the other (by vertex id) the pair meets in what it
+// shares. The other pairs take the exact test.
 
 #include "grid_check.hpp"
 
@@ -42,13 +50,18 @@ struct Placed {
     std::int64_t triangle; ///< index into LayeredTriangles::triangles
     Box box;
     bool proper;
+    /// Whether its corners lie in its cell's closed box (axis-aligned frames only); then `on[v]`
+    /// says which of the cell's faces corner v lies on: bit 2a for the face at the cell's lower
+    /// plane along axis a, bit 2a + 1 for the upper one.
+    bool boxed = false;
+    std::array<std::uint8_t, 3> on{};
     bool operator<(const Placed& o) const { return cell != o.cell ? cell < o.cell : triangle < o.triangle; }
 };
 
 /// The triangles of one layer sorted by cell, with where each row of cells starts.
 struct Layer {
     std::vector<Placed> placed;
-    std::vector<std::size_t> row_start; ///< ny - 1 + 1 entries
+    std::vector<std::uint32_t> cell_start; ///< per cell j * (nx - 1) + i its first entry, and the end
 };
 
 } // namespace
@@ -119,6 +132,7 @@ public:
         const Mat3 it = inverse_transpose(m_.frame);
         for (std::size_t r = 0; r < 3; ++r)
             for (std::size_t c = 0; c < 3; ++c) to_index_[r][c] = it[c][r];
+        set_planes();
     }
 
     GridGeometry run()
@@ -202,6 +216,52 @@ private:
 
     const std::uint32_t* corners(std::int64_t t) const { return &m_.triangles[static_cast<std::size_t>(3 * t)]; }
 
+    /// The grid's planes in world coordinates, as extract() rounds them (origin + step * index, to
+    /// float), for an axis-aligned frame whose planes strictly increase or decrease; otherwise
+    /// none, and every pair takes the exact test.
+    void set_planes()
+    {
+        for (std::size_t r = 0; r < 3; ++r)
+            for (std::size_t c = 0; c < 3; ++c)
+                if (r != c && m_.frame[r][c] != 0) return;
+        std::array<std::vector<float>, 3> planes;
+        for (std::size_t a = 0; a < 3; ++a) {
+            const double step = m_.frame[a][a];
+            if (!std::isfinite(step) || step == 0) return;
+            auto& p = planes[a];
+            p.resize(static_cast<std::size_t>(m_.dims[a]));
+            for (std::size_t i = 0; i < p.size(); ++i) {
+                p[i] = static_cast<float>(m_.origin[a] + step * static_cast<double>(i));
+                if (!std::isfinite(p[i])) return;
+                // strictly monotone: cells that are not neighbours have disjoint boxes
+                if (i > 0 && !(step > 0 ? p[i - 1] < p[i] : p[i - 1] > p[i])) return;
+            }
+        }
+        planes_ = std::move(planes);
+        axis_aligned_ = true;
+    }
+
+    /// Whether corners p of cell (i, j, k) lie in its closed box; if so, sets `on` (see Placed).
+    bool place_in_box(const std::array<Point3, 3>& p, std::int64_t i, std::int64_t j, std::int64_t k,
+                      std::array<std::uint8_t, 3>& on) const
+    {
+        const std::int64_t cell[3] = {i, j, k};
+        on = {};
+        for (std::size_t a = 0; a < 3; ++a) {
+            const auto at = static_cast<std::size_t>(cell[a]);
+            if (at + 1 >= planes_[a].size()) return false;
+            const double low = planes_[a][at], high = planes_[a][at + 1];
+            const double lo = std::fmin(low, high), hi = std::fmax(low, high);
+            for (std::size_t v = 0; v < 3; ++v) {
+                const double x = p[v][a];
+                if (!(x >= lo && x <= hi)) return false;
+                if (x == low) on[v] = static_cast<std::uint8_t>(on[v] | 1u << (2 * a));
+                if (x == high) on[v] = static_cast<std::uint8_t>(on[v] | 1u << (2 * a + 1));
+            }
+        }
+        return true;
+    }
+
     /// Layer z's triangles (z relative to k0), placed in their cells; counts strays, coincident
     /// corners of one triangle and (when `own`) zero-area triangles into `out`.
     void build(std::int64_t z, bool own, Layer& layer, GridGeometry& out) const
@@ -238,6 +298,7 @@ private:
                 if (!proper) ++out.zero_area_triangles;
             }
             Placed e{cj * cells_x_ + ci, t, {}, proper};
+            if (axis_aligned_) e.boxed = place_in_box(p, ci, cj, m_.k0 + z, e.on);
             for (std::size_t a = 0; a < 3; ++a) {
                 // the doubles hold floats exactly
                 e.box.lo[a] = static_cast<float>(std::min({p[0][a], p[1][a], p[2][a]}));
@@ -247,16 +308,70 @@ private:
         }
         // extract() writes triangles cell by cell: nearly sorted already
         if (!std::is_sorted(layer.placed.begin(), layer.placed.end())) std::sort(layer.placed.begin(), layer.placed.end());
-        layer.row_start.assign(static_cast<std::size_t>(cells_y_) + 1, 0);
+        const std::int64_t cells = cells_x_ * cells_y_;
+        if (layer.placed.size() >= std::numeric_limits<std::uint32_t>::max()) {
+            throw Error(Status::too_large, "grid_geometry: a cell layer holds more triangles than 32-bit offsets count");
+        }
+        layer.cell_start.resize(static_cast<std::size_t>(cells) + 1);
         std::size_t at = 0;
-        for (std::int64_t j = 0; j <= cells_y_; ++j) {
-            while (at < layer.placed.size() && layer.placed[at].cell < j * cells_x_) ++at;
-            layer.row_start[static_cast<std::size_t>(j)] = at;
+        for (std::int64_t c = 0; c <= cells; ++c) {
+            while (at < layer.placed.size() && layer.placed[at].cell < c) ++at;
+            layer.cell_start[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(at);
         }
     }
 
-    /// Tests the pair (a, b) of different triangles; counts what it finds into `out`.
-    void test_pair(const Placed& a, const Placed& b, GridGeometry& out) const
+    /// The faces (Placed::on bits) of a cell that hold its contact with the cell at offset d.
+    static unsigned contact_faces(const std::array<int, 3>& d)
+    {
+        unsigned faces = 0;
+        for (unsigned axis = 0; axis < 3; ++axis)
+            if (d[axis] != 0) faces |= 1u << (2 * axis + (d[axis] > 0 ? 1 : 0));
+        return faces;
+    }
+
+    /// Tests the pair (a, b) of triangles of neighbouring cells, b's cell at offset d from a's
+    /// (one step or none per axis, not all none); counts what it finds into `out`.
+    void test_neighbours(const Placed& a, const Placed& b, const std::array<int, 3>& d, GridGeometry& out) const
+    {
+        if (!a.boxed || !b.boxed) return test_pair(a, b, out);
+        const unsigned need_a = contact_faces(d), need_b = contact_faces({-d[0], -d[1], -d[2]});
+        std::uint32_t trace_a[3], trace_b[3];
+        int na = 0, nb = 0;
+        const std::uint32_t* a_ids = corners(a.triangle);
+        const std::uint32_t* b_ids = corners(b.triangle);
+        for (std::size_t v = 0; v < 3; ++v) {
+            if ((a.on[v] & need_a) == need_a) trace_a[na++] = a_ids[v];
+            if ((b.on[v] & need_b) == need_b) trace_b[nb++] = b_ids[v];
+        }
+        if (na == 0 || nb == 0) return; // the boxes meet only in the contact: disjoint
+        // distinct ids at one position lie in the contact, hence in both traces
+        int common = 0;
+        for (int x = 0; x < na; ++x)
+            for (int y = 0; y < nb; ++y) {
+                if (trace_a[x] == trace_b[y]) {
+                    ++common;
+                } else if (point(trace_a[x]) == point(trace_b[y])) {
+                    ++out.coincident;
+                }
+            }
+        if (!a.proper || !b.proper) return;
+        // a trace within the other: the pair meets in the hull of what it shares
+        if (common == na || common == nb) return;
+        // segment pq against segment qr, or point p against segment qr: not collinear, they meet
+        // only in q, or not at all
+        if (nb == 2 && (na == 1 || (na == 2 && common == 1))) {
+            std::uint32_t p = trace_a[0];
+            if (na == 2 && (p == trace_b[0] || p == trace_b[1])) p = trace_a[1];
+            if (!collinear(point(p), point(trace_b[0]), point(trace_b[1]))) return;
+        } else if (na == 2 && nb == 1) {
+            if (!collinear(point(trace_b[0]), point(trace_a[0]), point(trace_a[1]))) return;
+        }
+        test_pair(a, b, out, false);
+    }
+
+    /// Tests the pair (a, b) of different triangles; counts what it finds into `out` (coincident
+    /// corners too, unless the caller has).
+    void test_pair(const Placed& a, const Placed& b, GridGeometry& out, bool count_coincident = true) const
     {
         if (!boxes_meet(a.box, b.box)) return;
         const std::uint32_t* a_ids = corners(a.triangle);
@@ -272,7 +387,7 @@ private:
                 if (a_ids[ui] == b_ids[uj]) {
                     match[i] = j;
                     ++shared;
-                } else if (a_points[ui] == b_points[uj]) {
+                } else if (count_coincident && a_points[ui] == b_points[uj]) {
                     ++out.coincident;
                 }
             }
@@ -303,20 +418,12 @@ private:
         }
     }
 
-    /// Entries of `layer` in row j with cells i0..i1 (clamped to the grid).
-    std::pair<const Placed*, const Placed*> cells_of(const Layer& layer, std::int64_t j, std::int64_t i0,
-                                                     std::int64_t i1) const
+    /// Entries of `layer` in cell (i, j), none outside the grid.
+    std::pair<const Placed*, const Placed*> cell_of(const Layer& layer, std::int64_t i, std::int64_t j) const
     {
-        if (j < 0 || j >= cells_y_) return {nullptr, nullptr};
-        i0 = std::max<std::int64_t>(i0, 0);
-        i1 = std::min<std::int64_t>(i1, cells_x_ - 1);
-        const Placed* first = layer.placed.data() + layer.row_start[static_cast<std::size_t>(j)];
-        const Placed* last = layer.placed.data() + layer.row_start[static_cast<std::size_t>(j) + 1];
-        const std::int64_t lo = j * cells_x_ + i0, hi = j * cells_x_ + i1;
-        first = std::partition_point(first, last, [lo](const Placed& e) { return e.cell < lo; });
-        const Placed* end = first;
-        while (end < last && end->cell <= hi) ++end;
-        return {first, end};
+        if (j < 0 || j >= cells_y_ || i < 0 || i >= cells_x_) return {nullptr, nullptr};
+        const auto c = static_cast<std::size_t>(j * cells_x_ + i);
+        return {layer.placed.data() + layer.cell_start[c], layer.placed.data() + layer.cell_start[c + 1]};
     }
 
     /// Every pair of `own` (layer z) with itself and with `above` (layer z + 1, or null).
@@ -327,17 +434,31 @@ private:
             std::size_t h = g + 1;
             while (h < placed.size() && placed[h].cell == placed[g].cell) ++h;
             const std::int64_t cell = placed[g].cell, j = cell / cells_x_, i = cell % cells_x_;
-            const auto with = [&](std::pair<const Placed*, const Placed*> range) {
-                for (std::size_t a = g; a < h; ++a)
-                    for (const Placed* b = range.first; b != range.second; ++b) test_pair(placed[a], *b, out);
+            bool all_boxed = true;
+            for (std::size_t a = g; a < h; ++a) all_boxed = all_boxed && placed[a].boxed;
+            // the neighbour at offset d, unless every triangle here is boxed and none has a corner
+            // on the contact (then no pair with it can meet: test_neighbours)
+            const auto with = [&](const Layer& layer, int di, int dj, int dk) {
+                const std::array<int, 3> d{di, dj, dk};
+                if (all_boxed) {
+                    const unsigned need = contact_faces(d);
+                    bool touches = false;
+                    for (std::size_t a = g; a < h && !touches; ++a)
+                        for (std::size_t v = 0; v < 3; ++v) touches = touches || (placed[a].on[v] & need) == need;
+                    if (!touches) return;
+                }
+                const auto range = cell_of(layer, i + di, j + dj);
+                for (const Placed* b = range.first; b != range.second; ++b)
+                    for (std::size_t a = g; a < h; ++a) test_neighbours(placed[a], *b, d, out);
             };
             for (std::size_t a = g; a < h; ++a)
                 for (std::size_t b = a + 1; b < h; ++b) test_pair(placed[a], placed[b], out);
             // the cells after this one: (i + 1, j), (i - 1 .. i + 1, j + 1), and the nine above
-            with(cells_of(own, j, i + 1, i + 1));
-            with(cells_of(own, j + 1, i - 1, i + 1));
+            with(own, 1, 0, 0);
+            for (int di = -1; di <= 1; ++di) with(own, di, 1, 0);
             if (above) {
-                for (std::int64_t dj = -1; dj <= 1; ++dj) with(cells_of(*above, j + dj, i - 1, i + 1));
+                for (int dj = -1; dj <= 1; ++dj)
+                    for (int di = -1; di <= 1; ++di) with(*above, di, dj, 1);
             }
             g = h;
         }
@@ -366,6 +487,8 @@ private:
     GridCheckOptions options_;
     std::int64_t cells_x_ = 1, cells_y_ = 1;
     Mat3 to_index_{};
+    bool axis_aligned_ = false;
+    std::array<std::vector<float>, 3> planes_; ///< set_planes()
 };
 
 } // namespace
