@@ -203,23 +203,23 @@ void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
             std::sort(sorted.begin(), sorted.end());
             const auto distinct = std::unique(sorted.begin(), sorted.end()) - sorted.begin();
             if (distinct == 1) continue;
-            if (distinct == 2) {
-                const bool saddle = l[0] == l[2] && l[1] == l[3]; // both diagonals alike
-                if (saddle) {
-                    // the lower label's corners are joined across the face: cut off the higher's
-                    const std::int64_t high = sorted[1];
-                    for (unsigned i = 0; i < 4; ++i) {
-                        if (l[i] != high) continue;
-                        segment(q[i], q[(i + 1) % 4], midpoint(q[(i + 3) % 4], q[i]));
-                    }
-                } else {
-                    std::array<unsigned, 2> crossed{};
-                    unsigned found = 0;
-                    for (unsigned i = 0; i < 4; ++i) {
-                        if (l[i] != l[(i + 1) % 4]) crossed[found++] = i;
-                    }
-                    segment(q[crossed[0]], q[(crossed[0] + 1) % 4], midpoint(q[crossed[1]], q[(crossed[1] + 1) % 4]));
+            // a label on both ends of a diagonal is joined across the face (the lower one when both
+            // diagonals are alike, cmc33's tie rule): the other corners are cut off
+            const bool diagonal0 = l[0] == l[2], diagonal1 = l[1] == l[3];
+            if (diagonal0 || diagonal1) {
+                const std::int64_t joined = diagonal0 && diagonal1 ? sorted[0] : (diagonal0 ? l[0] : l[1]);
+                for (unsigned i = 0; i < 4; ++i) {
+                    if (l[i] != joined) segment(q[i], q[(i + 1) % 4], midpoint(q[(i + 3) % 4], q[i]));
                 }
+                continue;
+            }
+            if (distinct == 2) {
+                std::array<unsigned, 2> crossed{};
+                unsigned found = 0;
+                for (unsigned i = 0; i < 4; ++i) {
+                    if (l[i] != l[(i + 1) % 4]) crossed[found++] = i;
+                }
+                segment(q[crossed[0]], q[(crossed[0] + 1) % 4], midpoint(q[crossed[1]], q[(crossed[1] + 1) % 4]));
                 continue;
             }
             Doubled face_centre{1, 1, 1};

@@ -48,12 +48,14 @@ std::multiset<Tri> triangle_set(const Mesh& m, bool reverse)
     return out;
 }
 
-// A segment lies in the box's boundary when both ends share a coordinate at 0 or n - 1.
-bool on_box(const Point& a, const Point& b, const Index3& dims)
+// A segment lies in the box's boundary when both ends share a coordinate at its lowest or highest
+// (world positions of an axis-aligned frame with positive spacing, as the tests make).
+bool on_box(const Point& a, const Point& b, const Volume& v)
 {
     for (std::size_t c = 0; c < 3; ++c) {
-        const float hi = static_cast<float>(dims[c] - 1);
-        if ((a[c] == 0 && b[c] == 0) || (a[c] == hi && b[c] == hi)) return true;
+        const float lo = static_cast<float>(v.origin()[c]);
+        const float hi = static_cast<float>(v.origin()[c] + v.spacing()[c] * static_cast<double>(v.dims()[c] - 1));
+        if ((a[c] == lo && b[c] == lo) || (a[c] == hi && b[c] == hi)) return true;
     }
     return false;
 }
@@ -135,7 +137,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
             }
         }
         for (const auto& [edge, sides] : edges) {
-            if (on_box(edge.first, edge.second, volume.dims())) continue;
+            if (on_box(edge.first, edge.second, volume)) continue;
             // every label's sides pair up (a label meeting itself along the edge has 4: counted as
             // not manifold, not as open)
             const bool ok = std::all_of(sides.begin(), sides.end(), [](const auto& p) { return p.second % 2 == 0; });
@@ -152,6 +154,8 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
         const Mesh m = label_surface(s, label);
         const MeshTopology t = mesh_topology(m);
         const std::string what = name + ", label " + std::to_string(label);
+        counts.nonmanifold_edges += t.nonmanifold_edges;
+        counts.nonmanifold_vertices += t.nonmanifold_vertices;
         if (t.nonmanifold_edges != 0 || t.nonmanifold_vertices != 0) {
             fail(counts, counts.not_manifold, what + ": " + std::to_string(t.nonmanifold_edges) + " non-manifold edges, " +
                                                   std::to_string(t.nonmanifold_vertices) + " non-manifold vertices");
@@ -168,7 +172,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
             }
         }
         for (const auto& [edge, n] : uses) {
-            if (n == 1 && !on_box(edge.first, edge.second, volume.dims())) {
+            if (n == 1 && !on_box(edge.first, edge.second, volume)) {
                 fail(counts, counts.not_closed, what + ": a boundary edge off the box");
                 break;
             }

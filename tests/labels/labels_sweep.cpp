@@ -29,6 +29,7 @@ int main(int argc, char** argv)
             }
             std::cout << labels << " labels " << (smooth ? "smooth" : "iid") << ": fields " << c.fields << " surfaces "
                       << c.label_surfaces << " not_closed " << c.not_closed << " not_manifold " << c.not_manifold
+                      << " nonmanifold_edges " << c.nonmanifold_edges << " nonmanifold_vertices " << c.nonmanifold_vertices
                       << " not_oriented " << c.not_oriented << " not_embedded " << c.not_embedded
                       << " union_not_watertight " << c.union_not_watertight << " union_not_embedded "
                       << c.union_not_embedded << " repeated " << c.duplicate_triangles << " two_label_mismatch "

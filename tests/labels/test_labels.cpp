@@ -27,7 +27,7 @@ Counts sweep(int labels, int fields, bool smooth)
     }
     std::cout << labels << " labels, " << (smooth ? "smooth" : "i.i.d.") << ": " << c.fields << " fields, "
               << c.label_surfaces << " label surfaces; not closed " << c.not_closed << ", not manifold "
-              << c.not_manifold << ", not oriented " << c.not_oriented << ", not embedded " << c.not_embedded
+              << c.not_manifold << " (" << c.nonmanifold_edges << " edges, " << c.nonmanifold_vertices << " vertices)" << ", not oriented " << c.not_oriented << ", not embedded " << c.not_embedded
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
               << ", topology mismatches " << c.topology_mismatch << (c.first_failure.empty() ? "" : "; first: ")
