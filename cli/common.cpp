@@ -137,10 +137,58 @@ bool is_npy(const std::string& path)
     return npy;
 }
 
+/// The format of `path` among those that read --frame, --array or --series, as read_volume()
+/// chooses it (content first, then the name); "" for the others (NRRD, MetaImage, VTK, raw).
+std::string choice_format(const std::string& path)
+{
+    if (io::is_dicom_input(path)) return "DICOM";
+    if (io::is_tiff_input(path)) return "TIFF";
+    if (is_npy(path)) return ".npy";
+    std::error_code ec;
+    if (fs::is_regular_file(path, ec)) {
+        try {
+            const io::detail::InputFile file(path, path);
+            if (const auto format = io::detail::sniff_volume_format(file)) {
+                if (*format == io::VolumeFormat::nifti) return "NIfTI";
+                if (*format == io::VolumeFormat::vti) return ".vti";
+            }
+        } catch (const Error&) {
+            // unreadable: read_volume() says why
+        }
+    }
+    const std::string name = io::detail::lower_ascii(fs::path(path).filename().string());
+    if (name.ends_with(".vti")) return ".vti";
+    if (name.ends_with(".nii") || name.ends_with(".nii.gz") || name.ends_with(".hdr") || name.ends_with(".hdr.gz")) return "NIfTI";
+    // a NIfTI pair named by its data file (x.img or x.img.gz beside its header)
+    if ((name.ends_with(".img") || name.ends_with(".img.gz")) && io::volume_files(path).size() == 2) return "NIfTI";
+    return "";
+}
+
+/// --frame, --array and --series for an input whose format has no use for them: a usage error,
+/// not an option silently ignored.
+void check_volume_choices(const std::string& path, const RawVolumeOptions& raw)
+{
+    if (!raw.frame && raw.array.empty() && raw.series.empty()) return;
+    const std::string format = choice_format(path);
+    if (raw.frame && format != "NIfTI" && format != ".npy" && format != "TIFF") {
+        throw UsageError("--frame is for files holding several frames (4-D NIfTI, 4-D .npy, TIFF hyperstacks); " + path +
+                         (format.empty() ? " holds one volume" : " is " + format + ", read as one volume"));
+    }
+    if (!raw.array.empty() && format != ".vti") {
+        throw UsageError("--array is for .vti files, which can hold several point-data arrays; " + path + " is " +
+                         (format.empty() ? std::string("not a .vti file") : format));
+    }
+    if (!raw.series.empty() && format != "DICOM") {
+        throw UsageError("--series is for DICOM inputs, which can hold several series; " + path + " is " +
+                         (format.empty() ? std::string("not DICOM") : format));
+    }
+}
+
 } // namespace
 
 io::ReadOptions read_options(const std::string& path, const RawVolumeOptions& raw)
 {
+    check_volume_choices(path, raw);
     io::ReadOptions options;
     options.frame = raw.frame;
     options.array = raw.array;
