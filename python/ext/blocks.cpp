@@ -206,19 +206,28 @@ template <class T> BlockResult extract_block(GridView<T> grid, const BlockArgs& 
     std::vector<std::uint32_t> index(nv, kUnused);
     BlockResult r;
     r.sample_bound = p.sample_bound;
-    for (std::size_t f = 0; f < nt; ++f) {
+    const auto owned = [&](std::size_t f) {
         const I64 c = p.triangle_cells[f];
         const I64 ci = c % nx, cj = (c / nx) % ny, ck = c / (nx * ny);
-        if (ci < a.own_lo[0] || ci >= a.own_hi[0] || cj < a.own_lo[1] || cj >= a.own_hi[1] || ck < a.own_lo[2] ||
-            ck >= a.own_hi[2]) {
-            continue;
-        }
+        return ci >= a.own_lo[0] && ci < a.own_hi[0] && cj >= a.own_lo[1] && cj < a.own_hi[1] && ck >= a.own_lo[2] &&
+               ck < a.own_hi[2];
+    };
+    // exact sizes first: the block's arrays are its worker's largest, and growing them doubles
+    std::size_t kept_triangles = 0;
+    for (std::size_t f = 0; f < nt; ++f) kept_triangles += owned(f) ? 1 : 0;
+    r.triangles.reserve(kept_triangles * 3);
+    for (std::size_t f = 0; f < nt; ++f) {
+        if (!owned(f)) continue;
         for (std::size_t e = 0; e < 3; ++e) {
             std::uint32_t& id = index[p.triangles[f * 3 + e]];
             if (id == kUnused) id = 0; // marked used; numbered below in vertex order
             r.triangles.push_back(p.triangles[f * 3 + e]);
         }
     }
+    const auto used = static_cast<std::size_t>(std::count_if(index.begin(), index.end(), [](std::uint32_t id) { return id != kUnused; }));
+    r.keys.reserve(used);
+    r.positions.reserve(used * 3);
+    if (a.normals) r.normals.reserve(used * 3);
     const I64 NX = a.dims[0], NY = a.dims[1];
     I64 previous_cell = std::numeric_limits<I64>::min();
     I64 units_cell = std::numeric_limits<I64>::min();
