@@ -5,6 +5,8 @@
 # crashed, leaked, hung or ran out of memory. Crash inputs are kept in build-fuzz/fuzz-work/.
 #
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   targets: nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff
+#   nifti npy vti. The build reads DICOM through GDCM where it is installed (fuzz_dicom fuzzes the
+#   code around it; without GDCM every DICOM input is refused and the target fuzzes little).
 # Environment: FUZZ_RUNS=N stops each target after N executions instead (SECONDS then caps the
 # time); FUZZ_NO_BUILD=1 skips the build (for running several instances side by side).
 set -euo pipefail
@@ -26,7 +28,7 @@ if [[ "${FUZZ_NO_BUILD:-0}" != 1 ]]; then
     scripts/install-deps.sh --fuzz
     if [[ ! -f build-fuzz/CMakeCache.txt ]]; then
         CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-            -DCMC33_BUILD_FUZZ=ON -DCMC33_BUILD_TESTS=OFF -DCMC33_BUILD_CLI=OFF >/dev/null
+            -DCMC33_BUILD_FUZZ=ON -DCMC33_BUILD_TESTS=OFF -DCMC33_BUILD_CLI=OFF -DCMC33_WITH_GDCM=ON >/dev/null
     fi
     cmake --build build-fuzz -j2 >/dev/null
 fi
