@@ -47,7 +47,8 @@ void write_interfaces_ply(const LabelSurfaces& s, const std::string& path)
 {
     bool fits_int = true;
     for (const std::int64_t l : s.present) {
-        fits_int = fits_int && l >= std::numeric_limits<std::int32_t>::min() && l <= std::numeric_limits<std::int32_t>::max();
+        fits_int =
+            fits_int && l >= std::numeric_limits<std::int32_t>::min() && l <= std::numeric_limits<std::int32_t>::max();
     }
     const Mesh& m = s.interfaces;
     io::detail::write_atomically(path, [&](std::ostream& out) {
@@ -55,10 +56,11 @@ void write_interfaces_ply(const LabelSurfaces& s, const std::string& path)
         out << "ply\nformat binary_little_endian 1.0\ncomment cmc33 labels: interface triangles; the normal (counter-"
                "clockwise winding) points into label `front`\nelement vertex "
             << m.vertex_count() << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
-            << m.triangle_count() << "\nproperty list uchar int vertex_indices\nproperty " << type << " front\nproperty "
-            << type << " behind\nend_header\n";
+            << m.triangle_count() << "\nproperty list uchar int vertex_indices\nproperty " << type
+            << " front\nproperty " << type << " behind\nend_header\n";
         // little-endian hosts only (as the library's PLY writer): bytes as they are in memory
-        out.write(reinterpret_cast<const char*>(m.positions.data()), static_cast<std::streamsize>(m.positions.size() * 4));
+        out.write(reinterpret_cast<const char*>(m.positions.data()),
+                  static_cast<std::streamsize>(m.positions.size() * 4));
         for (std::size_t t = 0; t < m.triangle_count(); ++t) {
             char face[1 + 12 + 8];
             face[0] = 3;
@@ -82,7 +84,8 @@ void run_labels(const LabelsArgs& args)
     }
     const bool single = ends_with(args.output, ".ply") && !fs::is_directory(args.output);
     if (ends_with(args.output, ".glb") || ends_with(args.output, ".gltf")) {
-        throw UsageError("-o " + args.output + ": one glTF scene of all labels is not written yet; give a folder (one file "
+        throw UsageError("-o " + args.output +
+                         ": one glTF scene of all labels is not written yet; give a folder (one file "
                          "per label, --format glb) or a .ply of the interfaces");
     }
     if (single) {
@@ -96,7 +99,8 @@ void run_labels(const LabelsArgs& args)
         check_mesh_output((where / ("label_0." + args.format)).string(), false, false, {args.input});
     }
     const Volume volume = load_volume(args.input, args.raw);
-    const LabelSurfaces s = named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
+    const LabelSurfaces s =
+        named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
 
     Json labels = Json::array();
     if (single) {
@@ -168,26 +172,27 @@ void add_labels(CLI::App& app)
     cmd->add_option("--background", args->background, "The label without a surface (default 0); it still takes part")
         ->type_name("VALUE")
         ->check(whole_number(std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()));
-    cmd->add_option("--format", args->format, "Format of a folder's files: ply (default), obj, stl, off, glb, gltf, vtp, gii")
+    cmd->add_option("--format", args->format,
+                    "Format of a folder's files: ply (default), obj, stl, off, glb, gltf, vtp, gii")
         ->type_name("EXT")
         ->check(CLI::IsMember({"ply", "obj", "stl", "off", "glb", "gltf", "vtp", "gii"}));
     cmd->add_flag("--json", args->json, "Print one JSON object: every label's file, size, topology and embedding");
-    cmd->add_option("--threads", args->threads, "Worker threads of the --json checks, 0 = all cores (the surfaces: one)")
+    cmd->add_option("--threads", args->threads,
+                    "Worker threads of the --json checks, 0 = all cores (the surfaces: one)")
         ->type_name("N")
         ->check(thread_count());
     add_raw_volume_options(*cmd, args->raw);
-    cmd->footer(
-        "Every point of the volume's box belongs to one label: the one whose indicator's trilinear\n"
-        "interpolant is largest there, ties to the lower label. Where two labels meet in a cell their\n"
-        "interface is cmc33's triangulation of the level set 0.5 of the lower label's indicator; cells\n"
-        "with three or more labels are cut by cones from the cell's centre (docs/labels.md). Each\n"
-        "label's surface is closed except on the volume's box, oriented outward and embedded, and\n"
-        "neighbouring labels share their interface triangles exactly.\n"
-        "\n"
-        "Examples:\n"
-        "  cmc33 labels seg.nrrd -o meshes/ --json\n"
-        "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
-        "  cmc33 labels seg.nrrd -o interfaces.ply");
+    cmd->footer("Every point of the volume's box belongs to one label: the one whose indicator's trilinear\n"
+                "interpolant is largest there, ties to the lower label. Where two labels meet in a cell their\n"
+                "interface is cmc33's triangulation of the level set 0.5 of the lower label's indicator; cells\n"
+                "with three or more labels are cut by cones from the cell's centre (docs/labels.md). Each\n"
+                "label's surface is closed except on the volume's box, oriented outward and embedded, and\n"
+                "neighbouring labels share their interface triangles exactly.\n"
+                "\n"
+                "Examples:\n"
+                "  cmc33 labels seg.nrrd -o meshes/ --json\n"
+                "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
+                "  cmc33 labels seg.nrrd -o interfaces.ply");
     cmd->callback([args] { run_labels(*args); });
 }
 

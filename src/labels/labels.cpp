@@ -109,10 +109,12 @@ public:
     }
 
     // Interior point `slot` of cmc33's triangulation of cell (i, j, k).
-    std::uint32_t interior_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int slot, const std::array<double, 3>& unit)
+    std::uint32_t interior_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int slot,
+                                  const std::array<double, 3>& unit)
     {
         const auto n = [&](std::size_t a) { return static_cast<std::uint64_t>(dims_[a] - 1); };
-        const std::uint64_t cell = static_cast<std::uint64_t>(i) + n(0) * (static_cast<std::uint64_t>(j) + n(1) * static_cast<std::uint64_t>(k));
+        const std::uint64_t cell = static_cast<std::uint64_t>(i) +
+                                   n(0) * (static_cast<std::uint64_t>(j) + n(1) * static_cast<std::uint64_t>(k));
         const std::uint64_t key = interior_base_ + kInteriorSlots * cell + static_cast<std::uint64_t>(slot);
         return vertex(key, {static_cast<double>(i) + unit[0], static_cast<double>(j) + unit[1],
                             static_cast<double>(k) + unit[2]});
@@ -149,8 +151,8 @@ private:
                 throw Error(Status::too_large, "the label surfaces have more than 4294967295 vertices");
             }
             for (std::size_t r = 0; r < 3; ++r) {
-                positions_.push_back(static_cast<float>(origin_[r] + m_[r][0] * index[0] + m_[r][1] * index[1] +
-                                                        m_[r][2] * index[2]));
+                positions_.push_back(
+                    static_cast<float>(origin_[r] + m_[r][0] * index[0] + m_[r][1] * index[1] + m_[r][2] * index[2]));
             }
         }
         return it->second;
@@ -169,7 +171,10 @@ private:
 
 using Doubled = std::array<int, 3>;
 
-Doubled corner_doubled(unsigned c) { return {2 * static_cast<int>(c & 1U), static_cast<int>(c & 2U), static_cast<int>(c >> 1 & 2U)}; }
+Doubled corner_doubled(unsigned c)
+{
+    return {2 * static_cast<int>(c & 1U), static_cast<int>(c & 2U), static_cast<int>(c >> 1 & 2U)};
+}
 
 Doubled midpoint(unsigned u, unsigned w)
 {
@@ -180,8 +185,7 @@ Doubled midpoint(unsigned u, unsigned w)
 // A cell with three or more labels: a triangle from the centre to every segment of every face's
 // curve. A segment starts at the midpoint of a face edge (u, w) whose labels differ and ends at
 // `to`; u's label lies on u's side of it.
-template <class Emit>
-void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
+template <class Emit> void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
 {
     const Doubled centre{1, 1, 1};
     const auto segment = [&](unsigned u, unsigned w, const Doubled& to) {
@@ -190,14 +194,17 @@ void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
         const Doubled n{p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]};
         const int side = n[0] * (cu[0] - 1) + n[1] * (cu[1] - 1) + n[2] * (cu[2] - 1);
         // the triangle's plane meets the face along the segment's line, which misses the corner u
-        if (side > 0) emit(centre, m, to, label[u], label[w]);
-        else emit(centre, m, to, label[w], label[u]);
+        if (side > 0)
+            emit(centre, m, to, label[u], label[w]);
+        else
+            emit(centre, m, to, label[w], label[u]);
     };
     for (unsigned axis = 0; axis < 3; ++axis) {
         const unsigned b = (axis + 1) % 3, c = (axis + 2) % 3;
         for (unsigned s = 0; s < 2; ++s) {
             // the face's corners in cyclic order
-            const std::array<unsigned, 4> q{s << axis, s << axis | 1U << b, s << axis | 1U << b | 1U << c, s << axis | 1U << c};
+            const std::array<unsigned, 4> q{s << axis, s << axis | 1U << b, s << axis | 1U << b | 1U << c,
+                                            s << axis | 1U << c};
             std::array<std::int64_t, 4> l{label[q[0]], label[q[1]], label[q[2]], label[q[3]]};
             std::array<std::int64_t, 4> sorted = l;
             std::sort(sorted.begin(), sorted.end());
@@ -231,8 +238,7 @@ void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
     }
 }
 
-template <class T>
-LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
+template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
 {
     LabelSurfaces out;
     // every label present, for the selection
@@ -253,10 +259,9 @@ LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
         std::sort(out.present.begin(), out.present.end());
     }
     for (const std::int64_t v : out.present) {
-        const bool chosen = options.labels.empty()
-                                ? v != options.background
-                                : std::any_of(options.labels.begin(), options.labels.end(),
-                                              [&](const auto& r) { return r[0] <= v && v <= r[1]; });
+        const bool chosen = options.labels.empty() ? v != options.background
+                                                   : std::any_of(options.labels.begin(), options.labels.end(),
+                                                                 [&](const auto& r) { return r[0] <= v && v <= r[1]; });
         if (chosen) out.selected.push_back(v);
     }
     Builder builder(g.dims, g.spacing, g.origin, g.direction, out.selected);
@@ -279,7 +284,9 @@ LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
                 }
                 bool two = true;
                 for (const std::int64_t l : label) two = two && (l == low || l == high);
-                const auto at = [&](const Doubled& d) { return builder.grid_vertex(2 * i + d[0], 2 * j + d[1], 2 * k + d[2]); };
+                const auto at = [&](const Doubled& d) {
+                    return builder.grid_vertex(2 * i + d[0], 2 * j + d[1], 2 * k + d[2]);
+                };
                 if (two) {
                     ++out.cells_two_labels;
                     if (!builder.wanted(low, high)) continue;
@@ -288,7 +295,8 @@ LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
                     for (const auto& tri : table[config].triangles) {
                         std::array<std::uint32_t, 3> v{};
                         for (std::size_t n = 0; n < 3; ++n) {
-                            v[n] = tri[n].interior ? builder.interior_vertex(i, j, k, tri[n].slot, tri[n].unit) : at(tri[n].doubled);
+                            v[n] = tri[n].interior ? builder.interior_vertex(i, j, k, tri[n].slot, tri[n].unit)
+                                                   : at(tri[n].doubled);
                         }
                         // cmc33's normals point from above (the lower label) to below
                         builder.add(v, high, low);
@@ -309,8 +317,10 @@ std::int64_t parse_value(std::string_view text, std::string_view whole)
     std::int64_t v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
     if (text.empty() || ec != std::errc{} || end != text.data() + text.size()) {
-        throw Error(Status::invalid_argument, "labels '" + std::string(whole) + "': expected 'all' or values and ranges such "
-                                              "as 1,3,7 or 2-9, got '" + std::string(text) + "'");
+        throw Error(Status::invalid_argument, "labels '" + std::string(whole) +
+                                                  "': expected 'all' or values and ranges such "
+                                                  "as 1,3,7 or 2-9, got '" +
+                                                  std::string(text) + "'");
     }
     return v;
 }
@@ -337,10 +347,11 @@ LabelRanges parse_label_ranges(std::string_view text)
             const std::int64_t v = parse_value(item, text);
             ranges.push_back({v, v});
         } else {
-            const std::int64_t a = parse_value(item.substr(0, dash), text), b = parse_value(item.substr(dash + 1), text);
+            const std::int64_t a = parse_value(item.substr(0, dash), text),
+                               b = parse_value(item.substr(dash + 1), text);
             if (a > b) {
-                throw Error(Status::invalid_argument, "labels '" + std::string(text) + "': the range '" + std::string(item) +
-                                                          "' ends before it starts");
+                throw Error(Status::invalid_argument, "labels '" + std::string(text) + "': the range '" +
+                                                          std::string(item) + "' ends before it starts");
             }
             ranges.push_back({a, b});
         }
@@ -352,8 +363,8 @@ LabelRanges parse_label_ranges(std::string_view text)
 LabelSurfaces label_surfaces(const Volume& labels, const LabelOptions& options)
 {
     if (labels.type() == ScalarType::f32 || labels.type() == ScalarType::f64) {
-        throw Error(Status::unsupported_format, "label maps need integer samples (int8 to uint32), got " +
-                                                    std::string(type_name(labels.type())));
+        throw Error(Status::unsupported_format,
+                    "label maps need integer samples (int8 to uint32), got " + std::string(type_name(labels.type())));
     }
     return labels.visit([&](const auto& view) -> LabelSurfaces {
         using T = std::remove_cvref_t<decltype(*view.data)>;

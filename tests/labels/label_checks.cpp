@@ -20,7 +20,10 @@ namespace {
 using Point = std::array<float, 3>;
 using Tri = std::array<Point, 3>;
 
-Point point(const Mesh& m, std::uint32_t v) { return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]}; }
+Point point(const Mesh& m, std::uint32_t v)
+{
+    return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
+}
 
 // The oriented triangle, rotated so that its smallest corner comes first.
 Tri oriented(const Mesh& m, std::size_t t)
@@ -91,7 +94,8 @@ Volume random_labels(std::int64_t n, int labels, std::uint64_t seed, bool smooth
                 int label = 1;
                 for (const auto& p : seeds) {
                     const double d = std::hypot(static_cast<double>(x) - p[0], static_cast<double>(y) - p[1],
-                                                static_cast<double>(z) - p[2]) + noise(rng);
+                                                static_cast<double>(z) - p[2]) +
+                                     noise(rng);
                     if (d < best) {
                         best = d;
                         label = static_cast<int>(p[3]);
@@ -146,7 +150,8 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
                 break;
             }
         }
-        if (!mesh_geometry(all).embedded()) fail(counts, counts.union_not_embedded, name + ": the union is not embedded");
+        if (!mesh_geometry(all).embedded())
+            fail(counts, counts.union_not_embedded, name + ": the union is not embedded");
     }
     // each label's surface
     for (const std::int64_t label : s.selected) {
@@ -157,8 +162,9 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
         counts.nonmanifold_edges += t.nonmanifold_edges;
         counts.nonmanifold_vertices += t.nonmanifold_vertices;
         if (t.nonmanifold_edges != 0 || t.nonmanifold_vertices != 0) {
-            fail(counts, counts.not_manifold, what + ": " + std::to_string(t.nonmanifold_edges) + " non-manifold edges, " +
-                                                  std::to_string(t.nonmanifold_vertices) + " non-manifold vertices");
+            fail(counts, counts.not_manifold,
+                 what + ": " + std::to_string(t.nonmanifold_edges) + " non-manifold edges, " +
+                     std::to_string(t.nonmanifold_vertices) + " non-manifold vertices");
         }
         if (!t.oriented) fail(counts, counts.not_oriented, what + ": not oriented");
         // boundary edges only on the box
@@ -196,8 +202,8 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
         }
         const FieldTopology f = field_topology(indicator, 0.5);
         const MeshTopology t = mesh_topology(m_low);
-        if (!f.determined || f.euler != t.euler || f.b0 != t.components || f.b1 != t.b1 || f.b2 != t.closed_components ||
-            f.boundary_loops != t.boundary_loops) {
+        if (!f.determined || f.euler != t.euler || f.b0 != t.components || f.b1 != t.b1 ||
+            f.b2 != t.closed_components || f.boundary_loops != t.boundary_loops) {
             fail(counts, counts.topology_mismatch, name + ": not the field's topology");
         }
     }

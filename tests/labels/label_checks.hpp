@@ -14,11 +14,11 @@ namespace cmc33::label_checks {
 struct Counts {
     std::int64_t fields = 0;
     std::int64_t label_surfaces = 0;
-    std::int64_t not_closed = 0;      ///< a boundary edge off the volume's box
-    std::int64_t not_manifold = 0;    ///< a non-manifold edge or vertex
+    std::int64_t not_closed = 0;                                  ///< a boundary edge off the volume's box
+    std::int64_t not_manifold = 0;                                ///< a non-manifold edge or vertex
     std::int64_t nonmanifold_edges = 0, nonmanifold_vertices = 0; ///< their sums over all surfaces
     std::int64_t not_oriented = 0;
-    std::int64_t not_embedded = 0;    ///< mesh_geometry of the label's surface
+    std::int64_t not_embedded = 0; ///< mesh_geometry of the label's surface
     std::int64_t union_not_watertight = 0;
     std::int64_t union_not_embedded = 0;
     std::int64_t duplicate_triangles = 0;

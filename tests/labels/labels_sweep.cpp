@@ -25,18 +25,21 @@ int main(int argc, char** argv)
                 const std::int64_t size = 5 + n % 5;
                 const std::uint64_t seed = first + static_cast<std::uint64_t>(n);
                 check_field(random_labels(size, labels, seed, smooth), c,
-                            std::to_string(labels) + " labels " + (smooth ? "smooth" : "iid") + " seed " + std::to_string(seed));
+                            std::to_string(labels) + " labels " + (smooth ? "smooth" : "iid") + " seed " +
+                                std::to_string(seed));
             }
             std::cout << labels << " labels " << (smooth ? "smooth" : "iid") << ": fields " << c.fields << " surfaces "
                       << c.label_surfaces << " not_closed " << c.not_closed << " not_manifold " << c.not_manifold
-                      << " nonmanifold_edges " << c.nonmanifold_edges << " nonmanifold_vertices " << c.nonmanifold_vertices
-                      << " not_oriented " << c.not_oriented << " not_embedded " << c.not_embedded
-                      << " union_not_watertight " << c.union_not_watertight << " union_not_embedded "
+                      << " nonmanifold_edges " << c.nonmanifold_edges << " nonmanifold_vertices "
+                      << c.nonmanifold_vertices << " not_oriented " << c.not_oriented << " not_embedded "
+                      << c.not_embedded << " union_not_watertight " << c.union_not_watertight << " union_not_embedded "
                       << c.union_not_embedded << " repeated " << c.duplicate_triangles << " two_label_mismatch "
                       << c.two_label_mismatch << " topology_mismatch " << c.topology_mismatch
                       << (c.first_failure.empty() ? "" : " first: " + c.first_failure) << std::endl;
-            ok = ok && c.not_closed + c.not_oriented + c.not_embedded + c.union_not_watertight + c.union_not_embedded +
-                               c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch == 0 &&
+            ok = ok &&
+                 c.not_closed + c.not_oriented + c.not_embedded + c.union_not_watertight + c.union_not_embedded +
+                         c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch ==
+                     0 &&
                  (labels > 2 || c.not_manifold == 0);
         }
     return ok ? 0 : 1;

@@ -22,12 +22,14 @@ Counts sweep(int labels, int fields, bool smooth)
     for (int n = 0; n < fields; ++n) {
         const std::int64_t size = 5 + n % 5;
         const Volume v = label_checks::random_labels(size, labels, static_cast<std::uint64_t>(n), smooth);
-        label_checks::check_field(v, c, std::to_string(labels) + " labels, " + (smooth ? "smooth" : "i.i.d.") + " field " +
-                                            std::to_string(n) + " (" + std::to_string(size) + "^3)");
+        label_checks::check_field(v, c,
+                                  std::to_string(labels) + " labels, " + (smooth ? "smooth" : "i.i.d.") + " field " +
+                                      std::to_string(n) + " (" + std::to_string(size) + "^3)");
     }
     std::cout << labels << " labels, " << (smooth ? "smooth" : "i.i.d.") << ": " << c.fields << " fields, "
               << c.label_surfaces << " label surfaces; not closed " << c.not_closed << ", not manifold "
-              << c.not_manifold << " (" << c.nonmanifold_edges << " edges, " << c.nonmanifold_vertices << " vertices)" << ", not oriented " << c.not_oriented << ", not embedded " << c.not_embedded
+              << c.not_manifold << " (" << c.nonmanifold_edges << " edges, " << c.nonmanifold_vertices
+              << " vertices), not oriented " << c.not_oriented << ", not embedded " << c.not_embedded
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
               << ", topology mismatches " << c.topology_mismatch << (c.first_failure.empty() ? "" : "; first: ")
@@ -74,7 +76,9 @@ TEST(Labels, Deterministic)
     const LabelSurfaces a = label_surfaces(v), b = label_surfaces(v);
     ASSERT_EQ(a.interfaces.positions.size(), b.interfaces.positions.size());
     ASSERT_EQ(a.interfaces.triangles.size(), b.interfaces.triangles.size());
-    EXPECT_EQ(std::memcmp(a.interfaces.positions.data(), b.interfaces.positions.data(), a.interfaces.positions.size() * 4), 0);
+    EXPECT_EQ(
+        std::memcmp(a.interfaces.positions.data(), b.interfaces.positions.data(), a.interfaces.positions.size() * 4),
+        0);
     EXPECT_TRUE(a.interfaces.triangles == b.interfaces.triangles);
     EXPECT_EQ(a.front, b.front);
     EXPECT_EQ(a.behind, b.behind);
@@ -132,8 +136,10 @@ TEST(Labels, WorldFrame)
     const LabelSurfaces world = label_surfaces(v);
     ASSERT_EQ(index.interfaces.vertex_count(), world.interfaces.vertex_count());
     for (std::size_t i = 0; i < index.interfaces.vertex_count(); ++i) {
-        EXPECT_EQ(world.interfaces.positions[3 * i], static_cast<float>(10 - 0.5 * static_cast<double>(index.interfaces.positions[3 * i])));
-        EXPECT_EQ(world.interfaces.positions[3 * i + 1], static_cast<float>(-3 + 2 * static_cast<double>(index.interfaces.positions[3 * i + 1])));
+        EXPECT_EQ(world.interfaces.positions[3 * i],
+                  static_cast<float>(10 - 0.5 * static_cast<double>(index.interfaces.positions[3 * i])));
+        EXPECT_EQ(world.interfaces.positions[3 * i + 1],
+                  static_cast<float>(-3 + 2 * static_cast<double>(index.interfaces.positions[3 * i + 1])));
     }
     for (const std::int64_t l : world.selected) {
         EXPECT_TRUE(mesh_topology(label_surface(world, l)).oriented);

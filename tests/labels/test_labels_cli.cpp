@@ -33,7 +33,9 @@ TEST(LabelsCli, FolderAndInterfaces)
     const Volume seg = label_checks::random_labels(8, 4, 5, true);
     io::write_volume(seg, dir / "seg.nrrd");
     const LabelSurfaces s = label_surfaces(seg);
-    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --background 2", dir / "err"), 0)
+    ASSERT_EQ(
+        run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --background 2", dir / "err"),
+        0)
         << test::read_file(dir / "err");
     for (const std::int64_t l : {1, 3, 4}) {
         const Mesh m = io::read_mesh(dir / "out" / ("label_" + std::to_string(l) + ".ply"));
@@ -60,7 +62,8 @@ TEST(LabelsCli, BadInput)
     EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
     EXPECT_FALSE(fs::exists(dir / "out"));
     io::write_volume(Volume(ScalarType::u8, {4, 4, 4}), dir / "u.nrrd");
-    EXPECT_EQ(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o2").string() + " --labels 5-1", dir / "err"), 2);
+    EXPECT_EQ(
+        run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o2").string() + " --labels 5-1", dir / "err"), 2);
     EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "none" / "o3").string(), dir / "err"), 0);
     EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o.glb").string(), dir / "err"), 0);
     EXPECT_FALSE(fs::exists(dir / "o.glb"));

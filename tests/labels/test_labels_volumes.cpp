@@ -42,7 +42,8 @@ void check_volume(const std::string& file, const std::vector<double>& thresholds
     const Volume seg = classes(io::read_volume(*path), thresholds);
     label_checks::Counts c;
     label_checks::check_field(seg, c, file);
-    std::cout << file << ": " << c.label_surfaces << " label surfaces; not manifold " << c.not_manifold
+    std::cout << file << ": " << c.label_surfaces << " label surfaces; not manifold " << c.not_manifold << " ("
+              << c.nonmanifold_edges << " edges, " << c.nonmanifold_vertices << " vertices)"
               << ", not closed " << c.not_closed << ", not oriented " << c.not_oriented << ", not embedded "
               << c.not_embedded << ", union not watertight " << c.union_not_watertight << ", union not embedded "
               << c.union_not_embedded << ", repeated " << c.duplicate_triangles << ", two-label mismatch "
@@ -56,8 +57,17 @@ void check_volume(const std::string& file, const std::vector<double>& thresholds
     }
 }
 
-TEST(LabelsVolumes, ToothThreeClasses) { check_volume("tooth_103x94x161_uint8.nrrd", {100, 190}); }
-TEST(LabelsVolumes, ToothTwoClasses) { check_volume("tooth_103x94x161_uint8.nrrd", {120}); }
-TEST(LabelsVolumes, CTheadThreeClasses) { check_volume("CThead_256x256x113_uint16.nrrd", {600, 1400}); }
+TEST(LabelsVolumes, ToothThreeClasses)
+{
+    check_volume("tooth_103x94x161_uint8.nrrd", {100, 190});
+}
+TEST(LabelsVolumes, ToothTwoClasses)
+{
+    check_volume("tooth_103x94x161_uint8.nrrd", {120});
+}
+TEST(LabelsVolumes, CTheadThreeClasses)
+{
+    check_volume("CThead_256x256x113_uint16.nrrd", {600, 1400});
+}
 
 } // namespace

@@ -16,9 +16,9 @@
 #include <string_view>
 #include <vector>
 
+#include "cmc33/labels_export.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/volume.hpp"
-#include "cmc33/labels_export.hpp"
 
 namespace cmc33 {
 
