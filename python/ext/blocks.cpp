@@ -180,8 +180,14 @@ struct BlockArgs {
     double bound = 0;
 };
 
+/// Vertex flags: kOwned on the copy the merge keeps (the block owning the cell at the edge's lower
+/// sample, clamped into the cells: every crossed edge's cells use its vertex, so that block has
+/// it); kExported on owned vertices of a block's lower faces, which the blocks below use too.
+constexpr std::uint8_t kOwned = 1, kExported = 2;
+
 struct BlockResult {
     std::vector<I64> keys;
+    std::vector<std::uint8_t> flags;
     std::vector<float> positions, normals;
     std::vector<std::uint32_t> triangles;
     double sample_bound = 0;
@@ -226,6 +232,7 @@ template <class T> BlockResult extract_block(GridView<T> grid, const BlockArgs& 
     }
     const auto used = static_cast<std::size_t>(std::count_if(index.begin(), index.end(), [](std::uint32_t id) { return id != kUnused; }));
     r.keys.reserve(used);
+    r.flags.reserve(used);
     r.positions.reserve(used * 3);
     if (a.normals) r.normals.reserve(used * 3);
     const I64 NX = a.dims[0], NY = a.dims[1];
@@ -254,6 +261,7 @@ template <class T> BlockResult extract_block(GridView<T> grid, const BlockArgs& 
             if (q >= units.size()) throw Error(Status::internal, "a cell has more interior vertices in its block than alone");
             const I64 g[3] = {i + a.lower[0], j + a.lower[1], k + a.lower[2]};
             r.keys.push_back(-1 - ((g[0] + NX * (g[1] + NY * g[2])) * 32 + static_cast<I64>(q)));
+            r.flags.push_back(kOwned); // only the cell's block has it
             for (std::size_t d = 0; d < 3; ++d) {
                 const double x = static_cast<double>(g[d]) + units[q][d];
                 r.positions.push_back(static_cast<float>(a.origin[d] + a.spacing[d] * x));
@@ -267,6 +275,14 @@ template <class T> BlockResult extract_block(GridView<T> grid, const BlockArgs& 
             const double t = crossing(va, vb, a.iso, delta);
             const I64 g[3] = {i + a.lower[0], j + a.lower[1], k + a.lower[2]};
             r.keys.push_back(3 * (g[0] + NX * (g[1] + NY * g[2])) + axis);
+            std::uint8_t flag = kOwned;
+            for (std::size_t d = 0; d < 3; ++d) {
+                const I64 first = a.lower[d] + a.own_lo[d], end = a.lower[d] + a.own_hi[d];
+                const I64 cell = std::min(g[d], a.dims[d] - 2);
+                if (cell < first || cell >= end) flag = 0;
+                if (g[d] == first && first > 0) flag |= kExported;
+            }
+            r.flags.push_back(flag & kOwned ? flag : std::uint8_t{0});
             for (std::size_t d = 0; d < 3; ++d) {
                 const double x = static_cast<double>(g[d]) + (static_cast<I64>(d) == axis ? t : 0.0);
                 r.positions.push_back(static_cast<float>(a.origin[d] + a.spacing[d] * x));
@@ -309,7 +325,7 @@ void bind_blocks(py::module_& m)
         py::object n = py::none();
         if (normals) n = to_numpy(std::move(r.normals), 3);
         return py::make_tuple(to_numpy(std::move(r.keys), 0), to_numpy(std::move(r.positions), 3), n,
-                              to_numpy(std::move(r.triangles), 3), bound_out);
+                              to_numpy(std::move(r.triangles), 3), bound_out, to_numpy(std::move(r.flags), 0));
     }, py::arg("samples"), py::arg("iso"), py::arg("method"), py::arg("lower"), py::arg("own_lo"), py::arg("own_hi"),
        py::arg("dims"), py::arg("spacing"), py::arg("origin"), py::arg("normals"), py::arg("bound"));
 }
