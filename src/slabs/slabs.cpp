@@ -24,6 +24,7 @@
 #include "cmc33/error.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/passes.hpp"
+#include "grid_check.hpp"
 #include "mesh_formats.hpp"
 #include "parallel.hpp"
 #include "plural.hpp"
@@ -616,6 +617,71 @@ struct RangeRun::Impl {
 #endif
     }
 
+    /// A cell layer beside a slab, for its analysis.
+    struct Layer {
+        std::vector<float> positions;
+        std::vector<std::uint32_t> triangles;
+    };
+
+    /// The geometric check of slab s by the grid's structure (grid_check.hpp), with the pairs of
+    /// its first cell layer and the layer below (the layer above is the next slab's); false when
+    /// the structure does not decide (a corner outside its cell, coincident vertices), and then
+    /// the general check runs.
+    template <class T>
+    bool structured_geometry(const GridView<T>& g, const Slab& s, std::int64_t fv, std::int64_t ft,
+                             const std::vector<float>& positions, const std::vector<std::uint32_t>& triangles,
+                             const std::vector<std::int64_t>& slab_layers, const Layer& below, const Layer& above,
+                             RangeResult& result) const
+    {
+        if (slab_layers.size() != static_cast<std::size_t>(s.b - s.a) + 1) return false;
+        const std::int64_t below_v = static_cast<std::int64_t>(below.positions.size() / 3);
+        const std::int64_t below_t = static_cast<std::int64_t>(below.triangles.size() / 3);
+        const bool has_below = s.a > 0;
+        std::vector<float> points;
+        points.reserve(below.positions.size() + positions.size() + above.positions.size());
+        points.insert(points.end(), below.positions.begin(), below.positions.end());
+        points.insert(points.end(), positions.begin(), positions.end());
+        points.insert(points.end(), above.positions.begin(), above.positions.end());
+        std::vector<std::uint32_t> ids;
+        ids.reserve(below.triangles.size() + triangles.size());
+        ids.insert(ids.end(), below.triangles.begin(), below.triangles.end());
+        ids.insert(ids.end(), triangles.begin(), triangles.end());
+        std::vector<std::int64_t> layer_first;
+        if (has_below) layer_first.push_back(0);
+        for (const std::int64_t first : slab_layers) layer_first.push_back(below_t + first);
+        detail::LayeredTriangles layers;
+        layers.dims = g.dims;
+        layers.origin = g.origin;
+        layers.frame = frame_matrix(g.spacing, g.direction);
+        layers.positions = {points.data(), points.size()};
+        layers.first_vertex = fv - below_v;
+        layers.triangles = {ids.data(), ids.size()};
+        layers.first_triangle = ft - below_t;
+        layers.layer_first = {layer_first.data(), layer_first.size()};
+        layers.k0 = has_below ? s.a - 1 : s.a;
+        detail::GridCheckOptions o;
+        o.threads = detail::resolve_threads(opt.extract.threads);
+        o.examples = 0;
+        detail::GridGeometry alone; // the layer below by itself: its own slab's
+        if (has_below && below_t > 0) {
+            layers.layer_first = {layer_first.data(), 2};
+            alone = detail::grid_geometry(layers, 1, o);
+            layers.layer_first = {layer_first.data(), layer_first.size()};
+        }
+        // the examples that count: pairs with a slab triangle
+        o.examples = GeometryPart::kExamples + static_cast<std::size_t>(alone.intersecting_pairs);
+        detail::GridGeometry all = detail::grid_geometry(layers, static_cast<std::int64_t>(layer_first.size()) - 1, o);
+        if (!all.decided()) return false;
+        GeometryPart part;
+        part.positions = static_cast<std::int64_t>(positions.size() / 3); // no two at one position
+        part.zero_area_triangles = all.zero_area_triangles - alone.zero_area_triangles;
+        part.intersecting_pairs = all.intersecting_pairs - alone.intersecting_pairs;
+        for (const auto& pair : all.examples)
+            if (pair[1] >= ft && part.examples.size() < GeometryPart::kExamples) part.examples.push_back(pair);
+        result.geometry.add(part);
+        return true;
+    }
+
     template <class T>
     void emit_slab(const GridView<T>& g, const Slab& s, std::vector<RangeCounts>& counts, std::int64_t fv, std::int64_t ft,
                    double bound, RecordWriter& writer, RangeResult& result) const
@@ -648,6 +714,13 @@ struct RangeRun::Impl {
                                         cmc33::emit(g, iso, opt.extract, counts[i], offsets[i], out);
                                     }
                                 });
+        // triangles of cell layer s.a + i from the slab's first, for the structured check
+        std::vector<std::int64_t> layer_first;
+        layer_first.reserve(static_cast<std::size_t>(s.b - s.a) + 2);
+        for (std::size_t i = 0; i < counts.size(); ++i)
+            for (std::int64_t k = counts[i].k0(); k < counts[i].k1(); ++k)
+                layer_first.push_back(offsets[i].first_triangle - ft + counts[i].plane_first_triangle(k));
+        layer_first.push_back(nt);
         counts.clear();
         result.emit_seconds += since(started);
         started = Clock::now();
@@ -659,10 +732,6 @@ struct RangeRun::Impl {
         started = Clock::now();
 
         // The cell layers on either side, emitted here from the buffer's outer planes.
-        struct Layer {
-            std::vector<float> positions;
-            std::vector<std::uint32_t> triangles;
-        };
         const auto layer = [&](std::int64_t k, std::int64_t first_v, std::int64_t first_t, bool before) {
             RangeCounts c = cmc33::count(g, iso, opt.extract, k, k + 1);
             c.share_sample_bound(bound);
@@ -683,6 +752,11 @@ struct RangeRun::Impl {
         const detail::SeamTopology topology =
             detail::SeamTopology::of_slab(detail::SlabTriangles{fv, nv, triangles, below.triangles});
         result.topology = detail::SeamTopology::merge(result.topology, topology);
+
+        if (structured_geometry(g, s, fv, ft, positions, triangles, layer_first, below, above, result)) {
+            result.analyse_seconds += since(started);
+            return;
+        }
 
         // Geometry: the combined mesh of the layer below and the slab, ids from `base`.
         const std::size_t below_v = below.positions.size() / 3, below_t = below.triangles.size() / 3;
