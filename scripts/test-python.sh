@@ -40,3 +40,7 @@ for test in test_vtk_filter.py "test_pvbatch.py --cmc33 build/cli/cmc33 --volume
     # shellcheck disable=SC2086
     "$work/wheel-venv/bin/python" tests/paraview/$test || [[ $? -eq 77 ]]
 done
+
+echo "== cmc33.dask on a LocalCluster against the in-memory mesh (tests/dask; exit 77: skipped), with the wheel's module"
+module=$("$work/wheel-venv/bin/python" -c 'import cmc33._cmc33 as m; print(m.__file__)')
+/usr/bin/python3 tests/dask/test_dask.py --module "$module" --source . --shared ../shared || [[ $? -eq 77 ]]
