@@ -290,6 +290,12 @@ void check_uniform(const std::vector<const Header*>& files, const std::string& l
                         str_cat(f->label, ": ", f->samples_per_pixel, " samples per pixel (", f->photometric.empty() ? "color" : f->photometric,
                                 "); expected one sample per pixel (MONOCHROME1 or MONOCHROME2), a scalar volume"));
         }
+        // PALETTE COLOR indices are no scalar, and GDCM's decoders assert on an unknown value (none: read as MONOCHROME2)
+        if (!f->photometric.empty() && f->photometric != "MONOCHROME1" && f->photometric != "MONOCHROME2") {
+            throw Error(Status::unsupported_format,
+                        str_cat(f->label, ": PhotometricInterpretation ", quote_bytes(f->photometric),
+                                "; expected MONOCHROME1 or MONOCHROME2 (one sample per pixel, a scalar volume)"));
+        }
         if (f->rows != a.rows || f->columns != a.columns) {
             throw Error(Status::bad_format, str_cat(label, ": mixed slice sizes in one series: ", a.label, " has ", a.columns, "x",
                                                     a.rows, " (columns x rows), ", f->label, " has ", f->columns, "x", f->rows));
