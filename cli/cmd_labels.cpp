@@ -2,6 +2,8 @@
 // shared (src/labels, docs/labels.md): a folder of one closed surface per label, or one PLY of
 // interface triangles with the labels on their two sides.
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -10,6 +12,7 @@
 #include <memory>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
@@ -73,6 +76,24 @@ void write_interfaces_ply(const LabelSurfaces& s, const std::string& path)
     });
 }
 
+/// The colour of the n-th label of a scene: hues a golden angle apart (so that neighbours in the
+/// list differ), saturation 0.6, value 0.9, as linear RGBA.
+std::array<float, 4> label_colour(std::size_t n)
+{
+    const double h = std::fmod(static_cast<double>(n) * 0.381966011250105, 1.0) * 6;
+    const double v = 0.9, s = 0.6, c = v * s, x = c * (1 - std::fabs(std::fmod(h, 2.0) - 1)), m = v - c;
+    const int sector = static_cast<int>(h) % 6;
+    const double rgb[6][3] = {{c, x, 0}, {x, c, 0}, {0, c, x}, {0, x, c}, {x, 0, c}, {c, 0, x}};
+    std::array<float, 4> out{0, 0, 0, 1};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const double srgb = rgb[sector][k] + m;
+        // sRGB to linear (IEC 61966-2-1), as glTF's baseColorFactor is linear
+        const double linear = srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4);
+        out[k] = static_cast<float>(linear);
+    }
+    return out;
+}
+
 void run_labels(const LabelsArgs& args)
 {
     LabelOptions options;
@@ -82,12 +103,8 @@ void run_labels(const LabelsArgs& args)
     } catch (const Error& e) {
         throw UsageError(std::string("--") + e.what());
     }
-    const bool single = ends_with(args.output, ".ply") && !fs::is_directory(args.output);
-    if (ends_with(args.output, ".glb") || ends_with(args.output, ".gltf")) {
-        throw UsageError("-o " + args.output +
-                         ": one glTF scene of all labels is not written yet; give a folder (one file "
-                         "per label, --format glb) or a .ply of the interfaces");
-    }
+    const bool scene = (ends_with(args.output, ".glb") || ends_with(args.output, ".gltf")) && !fs::is_directory(args.output);
+    const bool single = (scene || ends_with(args.output, ".ply")) && !fs::is_directory(args.output);
     if (single) {
         check_mesh_output(args.output, false, false, {args.input});
     } else {
@@ -103,7 +120,17 @@ void run_labels(const LabelsArgs& args)
         named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
 
     Json labels = Json::array();
-    if (single) {
+    if (scene) {
+        std::vector<Mesh> meshes;
+        meshes.reserve(s.selected.size());
+        std::vector<io::ScenePart> parts;
+        for (const std::int64_t value : s.selected) meshes.push_back(label_surface(s, value));
+        for (std::size_t i = 0; i < meshes.size(); ++i)
+            parts.push_back({&meshes[i], "label_" + std::to_string(s.selected[i]), label_colour(i)});
+        io::MeshWriteOptions wo;
+        wo.space = volume.space();
+        named_step(args.output, "writing the scene", [&] { io::write_scene(parts, args.output, wo); });
+    } else if (single) {
         named_step(args.output, "writing the interfaces", [&] { write_interfaces_ply(s, args.output); });
     } else {
         std::error_code ec;
@@ -114,7 +141,7 @@ void run_labels(const LabelsArgs& args)
     geometry_options.threads = args.threads;
     for (const std::int64_t value : s.selected) {
         const Mesh m = label_surface(s, value);
-        std::string file;
+        std::string file = scene ? args.output : std::string();
         if (!single) {
             file = (fs::path(args.output) / ("label_" + std::to_string(value) + "." + args.format)).string();
             io::MeshWriteOptions wo;
@@ -162,11 +189,12 @@ void add_labels(CLI::App& app)
         ->required()
         ->check(non_empty("a volume file"));
     cmd->add_option("-o,--output", args->output,
-                    "A folder (one file per label, label_<value>.<format>; made if missing) or a .ply of the "
-                    "interface triangles with face properties front and behind")
+                    "A folder (one file per label, label_<value>.<format>; made if missing), a .ply of the "
+                    "interface triangles with face properties front and behind, or a .glb/.gltf scene with a "
+                    "mesh per label, named label_<value>, each in its own colour")
         ->required()
         ->type_name("OUT")
-        ->check(non_empty("an output folder or .ply file"));
+        ->check(non_empty("an output folder, .ply, .glb or .gltf file"));
     cmd->add_option("--labels", args->labels, "Labels that get surfaces: all (default), a list 1,3,7, ranges 2-9")
         ->type_name("LIST");
     cmd->add_option("--background", args->background, "The label without a surface (default 0); it still takes part")
@@ -192,7 +220,8 @@ void add_labels(CLI::App& app)
                 "Examples:\n"
                 "  cmc33 labels seg.nrrd -o meshes/ --json\n"
                 "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
-                "  cmc33 labels seg.nrrd -o interfaces.ply");
+                "  cmc33 labels seg.nrrd -o interfaces.ply\n"
+                "  cmc33 labels seg.nrrd -o organs.glb");
     cmd->callback([args] { run_labels(*args); });
 }
 

@@ -537,7 +537,50 @@ void validate_arrays(const Mesh& mesh, const MeshWriteOptions& options, const st
     check(options.triangle_arrays, mesh.triangle_count(), "triangle", "triangles");
 }
 
+/// A glTF scene of `parts` to path (.glb, or .gltf with its buffer in STEM.bin).
+void write_gltf(const std::filesystem::path& path, const std::vector<detail::GltfPart>& parts,
+                const MeshWriteOptions& options)
+{
+    if (detail::lower_extension(path) == ".gltf") {
+        // The buffer goes to STEM.bin beside the JSON (a relative uri), written first: a .gltf on
+        // disk always finds its whole buffer.
+        std::filesystem::path bin = path;
+        bin.replace_extension(".bin");
+        detail::write_atomically(bin, [&](std::ostream& out) { detail::write_gltf_bin(parts, out); });
+        detail::write_atomically(path, [&](std::ostream& out) {
+            detail::write_gltf_json(parts, out, options, bin.filename().string());
+        });
+        return;
+    }
+    detail::write_atomically(path, [&](std::ostream& out) { detail::write_glb(parts, out, options, path.string()); });
+}
+
 } // namespace
+
+void write_scene(const std::vector<ScenePart>& parts, const std::filesystem::path& path, const MeshWriteOptions& options)
+{
+    const std::string name = path.string();
+    const std::string ext = detail::lower_extension(path);
+    if (ext != ".glb" && ext != ".gltf") {
+        throw Error(Status::unsupported_format,
+                    detail::concat(name, ": a scene of several meshes is written as glTF; expected .glb or .gltf"));
+    }
+    std::vector<detail::GltfPart> gltf;
+    for (const ScenePart& part : parts) {
+        if (!part.mesh) throw Error(Status::invalid_argument, detail::concat(name, ": a part of the scene has no mesh"));
+        if (part.colour) {
+            for (const float c : *part.colour)
+                if (!(c >= 0 && c <= 1)) {
+                    throw Error(Status::invalid_argument,
+                                detail::concat(name, ": part \"", part.name, "\" has a colour component ",
+                                               static_cast<double>(c), "; expected linear RGBA values in [0, 1]"));
+                }
+        }
+        validate_for_writing(*part.mesh, name);
+        gltf.push_back({part.mesh, part.name, part.colour});
+    }
+    write_gltf(path, gltf, options);
+}
 
 void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
                 const MeshWriteOptions& options)
@@ -561,22 +604,9 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
                                                       "triangles, not ",
                                                       mesh.triangle_count()));
     }
-    if (ext == ".gltf") {
-        // The buffer goes to STEM.bin beside the JSON (a relative uri), written first: a .gltf on
-        // disk always finds its whole buffer.
-        std::filesystem::path bin = path;
-        bin.replace_extension(".bin");
-        const std::vector<detail::GltfPart> parts{{&mesh, {}, {}}};
-        detail::write_atomically(bin, [&](std::ostream& out) { detail::write_gltf_bin(parts, out); });
-        detail::write_atomically(path, [&](std::ostream& out) {
-            detail::write_gltf_json(parts, out, options, bin.filename().string());
-        });
-        return;
-    }
+    if (ext == ".gltf" || ext == ".glb") return write_gltf(path, {{&mesh, {}, {}}}, options);
     detail::write_atomically(path, [&](std::ostream& out) {
-        if (ext == ".glb") {
-            detail::write_glb({{&mesh, {}, {}}}, out, options, name);
-        } else if (ext == ".vtp") {
+        if (ext == ".vtp") {
             detail::write_vtp(mesh, out, options, name);
         } else if (ext == ".gii") {
             detail::write_gifti(mesh, out, options, name);

@@ -236,6 +236,8 @@ def check_validator(case):
     empty = case.path("empty.glb")
     run([case.cmc33, "extract", case.volume, "--iso", "5", "-o", empty, "--quiet"])
     files.append(empty)
+    scenes, labels = label_scenes(case)
+    files += scenes
     r = subprocess.run([node, os.path.join(folder, "validate.mjs"), *files], capture_output=True, text=True)
     reports = [json.loads(line) for line in r.stdout.splitlines() if line.startswith("{")]
     if r.returncode != 0 or len(reports) != len(files):
@@ -249,7 +251,53 @@ def check_validator(case):
     if info.get("totalTriangleCount") != len(t):
         raise AssertionError(f"{files[0]}: the validator counts {info.get('totalTriangleCount')} triangles, "
                              f"expected {len(t)}")
+    # a label map's scene: one named, coloured mesh per label, as many triangles as the surfaces
+    for path, rep in zip(scenes, reports[-len(scenes):]):
+        want = sum(label["triangles"] for label in labels)
+        if rep["info"].get("totalTriangleCount") != want:
+            raise AssertionError(f"{path}: the validator counts {rep['info'].get('totalTriangleCount')} triangles, "
+                                 f"expected the label surfaces' {want}")
+        gltf = gltf_json(path)
+        names = [m.get("name") for m in gltf["meshes"]]
+        if names != [f"label_{label['value']}" for label in labels]:
+            raise AssertionError(f"{path}: meshes {names}, expected one per label {[l['value'] for l in labels]}")
+        colours = [tuple(m["pbrMetallicRoughness"]["baseColorFactor"]) for m in gltf["materials"]]
+        if len(set(colours)) != len(labels):
+            raise AssertionError(f"{path}: {len(set(colours))} distinct colours for {len(labels)} labels")
     return len(files)
+
+
+def label_scenes(case):
+    """A label map of three touching labels (.npy) as a .glb and a .gltf scene by `cmc33 labels`,
+    and the labels its --json lists."""
+    seg = case.path("labels.npy")
+    z, y, x = np.mgrid[0:20, 0:22, 0:24]
+    lab = np.zeros((20, 22, 24), np.uint8)
+    lab[(x - 8) ** 2 + (y - 10) ** 2 + (z - 10) ** 2 < 36] = 1
+    lab[(x - 15) ** 2 + (y - 11) ** 2 + (z - 9) ** 2 < 30] = 2
+    lab[(x > 18) & (y < 6)] = 3
+    np.save(seg, lab)
+    scenes, labels = [], None
+    for name in ("labels.glb", "labels.gltf"):
+        out = case.path(name)
+        r = subprocess.run([case.cmc33, "labels", seg, "-o", out, "--json"], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise AssertionError(f"cmc33 labels -o {name}: exit {r.returncode}: {r.stderr.strip()}")
+        labels = json.loads(r.stdout)["labels"]
+        scenes.append(out)
+    if [label["value"] for label in labels] != [1, 2, 3]:
+        raise AssertionError(f"cmc33 labels lists {[label['value'] for label in labels]}, expected 1, 2, 3")
+    return scenes, labels
+
+
+def gltf_json(path):
+    """The JSON of a .gltf, or of a .glb's first chunk (glTF 2.0, section 4.4)."""
+    with open(path, "rb") as f:
+        data = f.read()
+    if path.endswith(".gltf"):
+        return json.loads(data)
+    length = int.from_bytes(data[12:16], "little")
+    return json.loads(data[20:20 + length])
 
 
 # ---- GIfTI ----------------------------------------------------------------------------------

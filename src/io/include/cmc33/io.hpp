@@ -14,6 +14,7 @@
 /// Writers write a temporary file next to the target and rename it, so a failed write never leaves
 /// a half-written file behind.
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -128,6 +129,20 @@ struct MeshWriteOptions {
 /// written where the format carries them (PLY, OBJ, glTF, VTP, GIfTI).
 /// @throws Error{unsupported_format} for another extension, Error{io_error}.
 CMC33_IO_EXPORT void write_mesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
+
+/// One mesh of a scene (write_scene()): its name and base colour (linear RGBA in [0, 1]).
+struct ScenePart {
+    const Mesh* mesh = nullptr; ///< not owned
+    std::string name{};
+    std::optional<std::array<float, 4>> colour{};
+};
+
+/// Writes several meshes as one glTF 2.0 scene, .glb or .gltf (+ a .bin of the same stem beside
+/// it): a node and a mesh per part, named, with a material of its colour (a label map's surfaces).
+/// @throws Error{unsupported_format} for another extension, Error{invalid_argument} for a part
+/// without a mesh or a colour outside [0, 1], Error{io_error}.
+CMC33_IO_EXPORT void write_scene(const std::vector<ScenePart>& parts, const std::filesystem::path& path,
+                                 const MeshWriteOptions& options = {});
 
 /// Reads .ply (ASCII or binary, either endian), .obj, .stl (binary or ASCII) or .off. Polygons
 /// with more than three vertices are fanned. STL has no indices: exactly coincident vertices are
