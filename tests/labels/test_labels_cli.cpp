@@ -65,8 +65,16 @@ TEST(LabelsCli, BadInput)
     EXPECT_EQ(
         run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o2").string() + " --labels 5-1", dir / "err"), 2);
     EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "none" / "o3").string(), dir / "err"), 0);
-    EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "o.glb").string(), dir / "err"), 0);
-    EXPECT_FALSE(fs::exists(dir / "o.glb"));
+    // a glTF scene where its folder does not exist: refused before any work, nothing written
+    EXPECT_NE(run("labels " + (dir / "u.nrrd").string() + " -o " + (dir / "none" / "o.glb").string(), dir / "err"), 0);
+    EXPECT_FALSE(fs::exists(dir / "none"));
+    // and where it does: written (its contents are checked by the glTF validator, tests/io)
+    Volume two(ScalarType::u8, {4, 4, 4});
+    for (std::size_t i = 0; i < 32; ++i) two.bytes()[i] = std::byte{1};
+    io::write_volume(two, dir / "two.nrrd");
+    EXPECT_EQ(run("labels " + (dir / "two.nrrd").string() + " -o " + (dir / "o.glb").string(), dir / "err"), 0)
+        << test::read_file(dir / "err");
+    EXPECT_TRUE(fs::exists(dir / "o.glb"));
 }
 
 } // namespace
