@@ -250,7 +250,7 @@ private:
         for (std::size_t a = 0; a < 3; ++a) {
             const auto at = static_cast<std::size_t>(cell[a]);
             if (at + 1 >= planes_[a].size()) return false;
-            const double low = planes_[a][at], high = planes_[a][at + 1];
+            const double low = static_cast<double>(planes_[a][at]), high = static_cast<double>(planes_[a][at + 1]);
             const double lo = std::fmin(low, high), hi = std::fmax(low, high);
             for (std::size_t v = 0; v < 3; ++v) {
                 const double x = p[v][a];
