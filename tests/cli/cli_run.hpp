@@ -9,9 +9,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "test_support.hpp"
 
@@ -66,6 +68,31 @@ inline nlohmann::json parse(const Result& r)
         ADD_FAILURE() << "stdout is not JSON (" << e.what() << "):\n" << r.out << r.err;
         return nlohmann::json::object();
     }
+}
+
+/// Exit 2, the message on one line containing every one of `parts`, then the --help line.
+inline void expect_usage_error(const Result& r, const std::vector<std::string>& parts)
+{
+    EXPECT_EQ(r.code, 2) << r.err;
+    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+    const std::string first = r.err.substr(0, r.err.find('\n'));
+    for (const std::string& part : parts)
+        EXPECT_NE(first.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
+/// 8^3 uint8 samples of a ball: meshes to a closed surface at iso 100.
+inline std::string ball_samples()
+{
+    std::string bytes;
+    for (int k = 0; k < 8; ++k)
+        for (int j = 0; j < 8; ++j)
+            for (int i = 0; i < 8; ++i) {
+                const double x = i - 3.5, y = j - 3.5, z = k - 3.5;
+                bytes += static_cast<char>(x * x + y * y + z * z < 9 ? 200 : 0);
+            }
+    return bytes;
 }
 
 } // namespace cmc33::test::cli

@@ -22,6 +22,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::cli::quote;
+using test::cli::ball_samples;
+using test::cli::expect_usage_error;
 using test::cli::Result;
 using test::cli::run;
 
@@ -58,31 +60,6 @@ void expect_failure(const Result& r, const std::vector<std::string>& parts)
     for (const std::string& part : parts)
         EXPECT_NE(r.err.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
     EXPECT_EQ(r.out, "");
-}
-
-/// Exit 2, the message on one line containing every one of `parts`, then the --help line.
-void expect_usage_error(const Result& r, const std::vector<std::string>& parts)
-{
-    EXPECT_EQ(r.code, 2) << r.err;
-    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
-    const std::string first = r.err.substr(0, r.err.find('\n'));
-    for (const std::string& part : parts)
-        EXPECT_NE(first.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
-    EXPECT_EQ(r.out, "");
-}
-
-/// 8^3 uint8 samples of a ball: meshes to a closed surface at iso 100.
-std::string ball_samples()
-{
-    std::string bytes;
-    for (int k = 0; k < 8; ++k)
-        for (int j = 0; j < 8; ++j)
-            for (int i = 0; i < 8; ++i) {
-                const double x = i - 3.5, y = j - 3.5, z = k - 3.5;
-                bytes += static_cast<char>(x * x + y * y + z * z < 9 ? 200 : 0);
-            }
-    return bytes;
 }
 
 constexpr const char* kNrrdFields = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 8 8 8\nencoding: raw\n";
