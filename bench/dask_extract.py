@@ -5,9 +5,11 @@ whether the two meshes are the same vertex and triangle sets.
 
 The volume is a smooth uint8 field (a gyroid's level sets, plus a slow bump), N^3 samples made
 slab by slab into both a zarr store (C x C x C chunks) and a raw file, never whole in memory.
-Dask runs on a dask.distributed LocalCluster of worker processes (one thread each); each
-worker's peak is its process's peak resident size (getrusage), read after the extraction, with
-the size it had before any block ran (interpreter, Dask, numpy, cmc33) beside it.
+Dask runs on a dask.distributed LocalCluster of worker processes (one thread each; the default,
+--scheduler distributed) or on Dask's threaded scheduler in this process (--scheduler threads,
+--workers threads). On the cluster each worker's peak is its process's peak resident size, read
+after the extraction, with the size it had before any block ran (interpreter, Dask, numpy, cmc33)
+beside it.
 
     PYTHONPATH=<folder with the cmc33 package> /usr/bin/python3 bench/dask_extract.py \\
         --cmc33 build/cli/cmc33 --size 1024 --chunk 128 --work /tmp/dask-bench
@@ -81,6 +83,8 @@ def main() -> int:
     parser.add_argument("--size", type=int, default=1024)
     parser.add_argument("--chunk", type=int, default=128)
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--scheduler", choices=("distributed", "threads"), default="distributed",
+                        help="a LocalCluster of worker processes, or Dask's threaded scheduler")
     parser.add_argument("--iso", type=float, default=127.5)
     parser.add_argument("--memory-limit", default="256M", help="the CLI's --memory-limit")
     parser.add_argument("--work", type=Path, default=Path("/tmp/cmc33-dask-bench"))
@@ -111,27 +115,36 @@ def main() -> int:
     cli_peak = int((args.work / "cli.time").read_text().split()[-1]) / 1024.0 if timed else float("nan")
     print(f"cmc33 extract --memory-limit {args.memory_limit} --no-topology: {cli_time:.1f} s, peak {cli_peak:.0f} MiB", flush=True)
 
-    cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, memory_limit=0)
-    client = distributed.Client(cluster)
-    try:
-        # what every worker imports anyway, so that the growth is the blocks' own
-        client.run(lambda: [__import__(m) for m in ("cmc33.dask", "dask.array", "zarr", "numcodecs")])
-        base = client.run(peak_rss_mib)
-        arr = da.from_zarr(str(store))
-        t0 = time.perf_counter()
-        mesh = cd.extract_dask(arr, args.iso)
-        dask_time = time.perf_counter() - t0
-        peaks = client.run(peak_rss_mib)
-    finally:
-        client.close()
-        cluster.close()
     chunk_mib = c ** 3 / 2 ** 20
-    print(f"cmc33.dask, {args.workers} workers: {dask_time:.1f} s ({dask_time / cli_time:.2f}x the CLI); "
-          f"chunk {chunk_mib:.1f} MiB", flush=True)
-    for w in sorted(peaks):
-        print(f"  worker peak {peaks[w]:.0f} MiB (before the blocks: {base[w]:.0f} MiB; "
-              f"growth {peaks[w] - base[w]:.0f} MiB = {(peaks[w] - base[w]) / chunk_mib:.1f} chunks)")
+    arr = da.from_zarr(str(store))
+    if args.scheduler == "threads":
+        import dask
+        with dask.config.set(num_workers=args.workers):
+            t0 = time.perf_counter()
+            mesh = cd.extract_dask(arr, args.iso, scheduler="threads")
+            dask_time = time.perf_counter() - t0
+        print(f"cmc33.dask, threaded scheduler, {args.workers} threads: {dask_time:.1f} s "
+              f"({dask_time / cli_time:.2f}x the CLI); chunk {chunk_mib:.1f} MiB", flush=True)
+    else:
+        cluster = distributed.LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, memory_limit=0)
+        client = distributed.Client(cluster)
+        try:
+            # what every worker imports anyway, so that the growth is the blocks' own
+            client.run(lambda: [__import__(m) for m in ("cmc33.dask", "dask.array", "zarr", "numcodecs")])
+            base = client.run(peak_rss_mib)
+            t0 = time.perf_counter()
+            mesh = cd.extract_dask(arr, args.iso)
+            dask_time = time.perf_counter() - t0
+            peaks = client.run(peak_rss_mib)
+        finally:
+            client.close()
+            cluster.close()
+        print(f"cmc33.dask, {args.workers} workers: {dask_time:.1f} s ({dask_time / cli_time:.2f}x the CLI); "
+              f"chunk {chunk_mib:.1f} MiB", flush=True)
+        for w in sorted(peaks):
+            print(f"  worker peak {peaks[w]:.0f} MiB (before the blocks: {base[w]:.0f} MiB; "
+                  f"growth {peaks[w] - base[w]:.0f} MiB = {(peaks[w] - base[w]) / chunk_mib:.1f} chunks)")
 
     cli_mesh = cmc33.read_mesh(ply)
     gv, gt = canonical(mesh.vertices, mesh.triangles)
