@@ -21,10 +21,12 @@ set -euo pipefail
 # libgdcm-dev and libtiff-dev are the DICOM and TIFF readers' libraries (without them the build
 # configures and refuses those formats by name); python3-pydicom and python3-tifffile write the
 # volumes the DICOM and TIFF tests read (tests/io/*.py), as independent writers; python3-nibabel
-# and python3-vtk9 write the NIfTI and .vti files of tests/io/independent_writers.py.
+# and python3-vtk9 write the NIfTI and .vti files of tests/io/independent_writers.py; python3-meshio
+# reads back the PLY face properties of tests/io/test_mesh_ply_faces.cpp (VTK's PLY reader drops them).
 packages=(g++ cmake ninja-build pkg-config zlib1g-dev libdeflate-dev libgmp-dev libgtest-dev libgmock-dev
           libcli11-dev nlohmann-json3-dev libtbb-dev python3 libcgal-dev
-          libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile python3-nibabel python3-vtk9)
+          libgdcm-dev libtiff-dev python3-numpy python3-pydicom python3-tifffile python3-nibabel python3-vtk9
+          python3-meshio)
 # node and npm run the Khronos glTF validator of tests/io/mesh_writers.py (tests/io/gltf); a node
 # from elsewhere, with its own npm, is kept.
 command -v node >/dev/null || packages+=(nodejs)
