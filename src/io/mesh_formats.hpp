@@ -35,15 +35,31 @@ Mesh read_obj(std::string_view bytes, const std::string& name);
 Mesh read_stl(std::string_view bytes, const std::string& name);
 Mesh read_off(std::string_view bytes, const std::string& name);
 
+/// A triangle array (MeshWriteOptions::triangle_arrays) as PLY face properties after
+/// vertex_indices: one scalar property per component, named as the array (NAME_0, NAME_1, ... when
+/// it has several components), all of one 4-byte PLY type that holds every value exactly.
+struct PlyFaceArray {
+    const MeshArray* array = nullptr;
+    const char* type = "float"; ///< "float", "int" or "uint"
+};
+/// The face properties of `arrays`, checked before anything is written: a Float32 array is float,
+/// an Int32 array int, an Int64 array int when every value fits int32, uint when none is negative
+/// and every value fits uint32, else refused (PLY has no 64-bit integers). Property names must be
+/// PLY words (printable ASCII, no blank), distinct, and not vertex_indices / vertex_index.
+/// @throws Error{invalid_argument} naming the file `name` and the array.
+std::vector<PlyFaceArray> ply_face_arrays(const std::vector<MeshArray>& arrays, const std::string& name);
+
 // `offset` (3 doubles) or null: positions are written in double precision as offset + position
 // (a mesh extracted with its origin at 0, where 32-bit floats cannot keep it embedded in world space).
-void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* offset = nullptr);
-/// The header write_ply writes for a mesh of these sizes. A binary file continues with
-/// kPlyVertexBytes (kPlyNormalVertexBytes with normals) per vertex, then kPlyFaceBytes per
-/// triangle, so a writer that knows the sizes can place any slice of the mesh (out-of-core slabs,
-/// MPI ranks: src/slabs) at its offset.
+// `faces`: from ply_face_arrays(), one value per triangle and component each.
+void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* offset = nullptr,
+               const std::vector<PlyFaceArray>& faces = {});
+/// The header write_ply writes for a mesh of these sizes. A binary file without face arrays
+/// continues with kPlyVertexBytes (kPlyNormalVertexBytes with normals) per vertex, then
+/// kPlyFaceBytes per triangle, so a writer that knows the sizes can place any slice of the mesh
+/// (out-of-core slabs, MPI ranks: src/slabs) at its offset.
 CMC33_IO_EXPORT std::string ply_header(std::uint64_t vertices, std::uint64_t triangles, bool normals, bool ascii,
-                                       bool double_positions = false);
+                                       bool double_positions = false, const std::vector<PlyFaceArray>& faces = {});
 inline constexpr std::size_t kPlyVertexBytes = 12;       ///< float x y z
 inline constexpr std::size_t kPlyNormalVertexBytes = 24; ///< float x y z nx ny nz
 inline constexpr std::size_t kPlyFaceBytes = 13;         ///< uchar 3, uint a b c

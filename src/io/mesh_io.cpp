@@ -605,13 +605,16 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
                                                       mesh.triangle_count()));
     }
     if (ext == ".gltf" || ext == ".glb") return write_gltf(path, {{&mesh, {}, {}}}, options);
+    // checked (names, a PLY type for every value) before the file is opened
+    const std::vector<detail::PlyFaceArray> ply_faces =
+        ext == ".ply" ? detail::ply_face_arrays(options.triangle_arrays, name) : std::vector<detail::PlyFaceArray>{};
     detail::write_atomically(path, [&](std::ostream& out) {
         if (ext == ".vtp") {
             detail::write_vtp(mesh, out, options, name);
         } else if (ext == ".gii") {
             detail::write_gifti(mesh, out, options, name);
         } else if (ext == ".ply") {
-            detail::write_ply(mesh, out, options.ascii, offset);
+            detail::write_ply(mesh, out, options.ascii, offset, ply_faces);
         } else if (ext == ".obj") {
             detail::write_obj(mesh, out, offset);
         } else if (ext == ".stl") {

@@ -109,6 +109,13 @@ Array ints(std::string name, int components, const std::int32_t* values, std::si
             }};
 }
 
+Array longs(std::string name, int components, const std::int64_t* values, std::size_t size)
+{
+    return {"Int64", std::move(name), components, 8, size, [values](char* dst, std::size_t first, std::size_t n) {
+                for (std::size_t i = 0; i < n; ++i) store_le(dst + 8 * i, static_cast<std::uint64_t>(values[first + i]));
+            }};
+}
+
 Array named(const MeshArray& a)
 {
     return std::visit(
@@ -116,8 +123,10 @@ Array named(const MeshArray& a)
             using T = typename std::decay_t<decltype(span)>::element_type;
             if constexpr (std::is_same_v<T, const float>) {
                 return floats(a.name, a.components, span.data(), span.size());
-            } else {
+            } else if constexpr (std::is_same_v<T, const std::int32_t>) {
                 return ints(a.name, a.components, span.data(), span.size());
+            } else {
+                return longs(a.name, a.components, span.data(), span.size());
             }
         },
         a.values);

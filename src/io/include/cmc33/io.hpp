@@ -101,10 +101,13 @@ CMC33_IO_EXPORT void convert_space(Volume& volume, std::string_view space);
 CMC33_IO_EXPORT void write_volume(const Volume& volume, const std::filesystem::path& path);
 
 /// A named array written beside a mesh, one tuple of `components` values per vertex or per
-/// triangle (VTK XML PolyData point or cell data). Not owned: the values must outlive the write.
+/// triangle (VTK XML PolyData point or cell data; PLY face properties). Not owned: the values must
+/// outlive the write.
 struct MeshArray {
     std::string name;
-    std::variant<std::span<const float>, std::span<const std::int32_t>> values; ///< Float32 or Int32
+    /// Float32, Int32 or Int64 (in PLY, whose integers are 32-bit: int or uint when every value
+    /// fits one of them, else refused)
+    std::variant<std::span<const float>, std::span<const std::int32_t>, std::span<const std::int64_t>> values;
     int components = 1;
 };
 
@@ -120,8 +123,9 @@ struct MeshWriteOptions {
     /// "RAS", ...; empty: not known). glTF states it in `extras`; GIfTI writes RAS+ coordinates,
     /// converting from another anatomical space (docs/formats.md).
     std::string space{};
-    std::vector<MeshArray> vertex_arrays{};   ///< .vtp point data (e.g. the values at the vertices)
-    std::vector<MeshArray> triangle_arrays{}; ///< .vtp cell data (e.g. a label per triangle)
+    std::vector<MeshArray> vertex_arrays{}; ///< .vtp point data (e.g. the values at the vertices)
+    /// .vtp cell data, .ply face properties (e.g. a label per triangle)
+    std::vector<MeshArray> triangle_arrays{};
 };
 
 /// Writes .ply, .obj, .stl (binary), .off, .glb, .gltf (+ a .bin of the same stem beside it),
