@@ -55,8 +55,40 @@ struct Placed {
     /// plane along axis a, bit 2a + 1 for the upper one.
     bool boxed = false;
     std::array<std::uint8_t, 3> on{};
+    /// Bit offset_bit(d) set when the triangle may meet the contact with the neighbour at offset d:
+    /// a corner lies on it (boxed), or always (not boxed).
+    std::uint32_t touches = ~std::uint32_t{0};
     bool operator<(const Placed& o) const { return cell != o.cell ? cell < o.cell : triangle < o.triangle; }
 };
+
+/// The bit of neighbour offset d (one step or none per axis) in Placed::touches.
+constexpr unsigned offset_bit(int dx, int dy, int dz)
+{
+    return static_cast<unsigned>((dx + 1) + 3 * (dy + 1) + 9 * (dz + 1));
+}
+
+/// The faces (Placed::on bits) of a cell that hold its contact with the cell at offset d.
+constexpr unsigned contact_faces(int dx, int dy, int dz)
+{
+    const int d[3] = {dx, dy, dz};
+    unsigned faces = 0;
+    for (unsigned axis = 0; axis < 3; ++axis)
+        if (d[axis] != 0) faces |= 1u << (2 * axis + (d[axis] > 0 ? 1 : 0));
+    return faces;
+}
+
+/// For each set of faces a corner lies on (Placed::on), the offsets whose contact holds it.
+constexpr std::array<std::uint32_t, 64> kContactsOf = [] {
+    std::array<std::uint32_t, 64> table{};
+    for (unsigned on = 0; on < 64; ++on)
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx) {
+                    const unsigned need = contact_faces(dx, dy, dz);
+                    if (need != 0 && (on & need) == need) table[on] |= 1u << offset_bit(dx, dy, dz);
+                }
+    return table;
+}();
 
 /// The triangles of one layer sorted by cell, with where each row of cells starts.
 struct Layer {
@@ -209,6 +241,7 @@ private:
     Point3 index_of(const Point3& p) const
     {
         const double d[3] = {p[0] - m_.origin[0], p[1] - m_.origin[1], p[2] - m_.origin[2]};
+        if (axis_aligned_) return {to_index_[0][0] * d[0], to_index_[1][1] * d[1], to_index_[2][2] * d[2]};
         Point3 q{};
         for (std::size_t r = 0; r < 3; ++r) q[r] = to_index_[r][0] * d[0] + to_index_[r][1] * d[1] + to_index_[r][2] * d[2];
         return q;
@@ -299,6 +332,7 @@ private:
             }
             Placed e{cj * cells_x_ + ci, t, {}, proper};
             if (axis_aligned_) e.boxed = place_in_box(p, ci, cj, m_.k0 + z, e.on);
+            if (e.boxed) e.touches = kContactsOf[e.on[0]] | kContactsOf[e.on[1]] | kContactsOf[e.on[2]];
             for (std::size_t a = 0; a < 3; ++a) {
                 // the doubles hold floats exactly
                 e.box.lo[a] = static_cast<float>(std::min({p[0][a], p[1][a], p[2][a]}));
@@ -313,28 +347,25 @@ private:
             throw Error(Status::too_large, "grid_geometry: a cell layer holds more triangles than 32-bit offsets count");
         }
         layer.cell_start.resize(static_cast<std::size_t>(cells) + 1);
-        std::size_t at = 0;
-        for (std::int64_t c = 0; c <= cells; ++c) {
-            while (at < layer.placed.size() && layer.placed[at].cell < c) ++at;
-            layer.cell_start[static_cast<std::size_t>(c)] = static_cast<std::uint32_t>(at);
+        // cells (previous one's, this one's] start where this one's entries do: filled in runs,
+        // as most cells are empty
+        auto* start = layer.cell_start.data();
+        std::int64_t filled = 0; // cell_start[0, filled) is set
+        for (std::size_t at = 0; at < layer.placed.size(); ++at) {
+            const std::int64_t c = layer.placed[at].cell;
+            if (c < filled) continue;
+            std::fill(start + filled, start + c + 1, static_cast<std::uint32_t>(at));
+            filled = c + 1;
         }
+        std::fill(start + filled, start + cells + 1, static_cast<std::uint32_t>(layer.placed.size()));
     }
 
-    /// The faces (Placed::on bits) of a cell that hold its contact with the cell at offset d.
-    static unsigned contact_faces(const std::array<int, 3>& d)
-    {
-        unsigned faces = 0;
-        for (unsigned axis = 0; axis < 3; ++axis)
-            if (d[axis] != 0) faces |= 1u << (2 * axis + (d[axis] > 0 ? 1 : 0));
-        return faces;
-    }
-
-    /// Tests the pair (a, b) of triangles of neighbouring cells, b's cell at offset d from a's
-    /// (one step or none per axis, not all none); counts what it finds into `out`.
-    void test_neighbours(const Placed& a, const Placed& b, const std::array<int, 3>& d, GridGeometry& out) const
+    /// Tests the pair (a, b) of triangles of neighbouring cells, b's cell at an offset from a's
+    /// whose contact is faces `need_a` of a's cell and `need_b` of b's (contact_faces); counts
+    /// what it finds into `out`.
+    void test_neighbours(const Placed& a, const Placed& b, unsigned need_a, unsigned need_b, GridGeometry& out) const
     {
         if (!a.boxed || !b.boxed) return test_pair(a, b, out);
-        const unsigned need_a = contact_faces(d), need_b = contact_faces({-d[0], -d[1], -d[2]});
         std::uint32_t trace_a[3], trace_b[3];
         int na = 0, nb = 0;
         const std::uint32_t* a_ids = corners(a.triangle);
@@ -344,19 +375,19 @@ private:
             if ((b.on[v] & need_b) == need_b) trace_b[nb++] = b_ids[v];
         }
         if (na == 0 || nb == 0) return; // the boxes meet only in the contact: disjoint
-        // distinct ids at one position lie in the contact, hence in both traces
         int common = 0;
         for (int x = 0; x < na; ++x)
-            for (int y = 0; y < nb; ++y) {
-                if (trace_a[x] == trace_b[y]) {
-                    ++common;
-                } else if (point(trace_a[x]) == point(trace_b[y])) {
-                    ++out.coincident;
-                }
-            }
-        if (!a.proper || !b.proper) return;
-        // a trace within the other: the pair meets in the hull of what it shares
+            for (int y = 0; y < nb; ++y) common += trace_a[x] == trace_b[y] ? 1 : 0;
+        // a trace within the other: the pair meets in the hull of what it shares. Distinct ids at
+        // one position lie in the contact, hence in both traces: here both in one triangle, which
+        // build() counts
         if (common == na || common == nb) return;
+        for (int x = 0; x < na; ++x)
+            for (int y = 0; y < nb; ++y)
+                if (trace_a[x] != trace_b[y] && point(trace_a[x]) == point(trace_b[y])) ++out.coincident;
+        if (!a.proper || !b.proper) return;
+        // two points of distinct ids: they meet only if the points coincide, counted above
+        if (na == 1 && nb == 1) return;
         // segment pq against segment qr, or point p against segment qr: not collinear, they meet
         // only in q, or not at all
         if (nb == 2 && (na == 1 || (na == 2 && common == 1))) {
@@ -434,22 +465,20 @@ private:
             std::size_t h = g + 1;
             while (h < placed.size() && placed[h].cell == placed[g].cell) ++h;
             const std::int64_t cell = placed[g].cell, j = cell / cells_x_, i = cell % cells_x_;
-            bool all_boxed = true;
-            for (std::size_t a = g; a < h; ++a) all_boxed = all_boxed && placed[a].boxed;
-            // the neighbour at offset d, unless every triangle here is boxed and none has a corner
-            // on the contact (then no pair with it can meet: test_neighbours)
+            std::uint32_t group_touches = 0;
+            for (std::size_t a = g; a < h; ++a) group_touches |= placed[a].touches;
+            // the neighbour at offset d: only the pairs whose traces on the contact are both
+            // non-empty can meet (test_neighbours)
             const auto with = [&](const Layer& layer, int di, int dj, int dk) {
-                const std::array<int, 3> d{di, dj, dk};
-                if (all_boxed) {
-                    const unsigned need = contact_faces(d);
-                    bool touches = false;
-                    for (std::size_t a = g; a < h && !touches; ++a)
-                        for (std::size_t v = 0; v < 3; ++v) touches = touches || (placed[a].on[v] & need) == need;
-                    if (!touches) return;
-                }
+                const std::uint32_t bit_a = 1u << offset_bit(di, dj, dk), bit_b = 1u << offset_bit(-di, -dj, -dk);
+                if ((group_touches & bit_a) == 0) return;
+                const unsigned need_a = contact_faces(di, dj, dk), need_b = contact_faces(-di, -dj, -dk);
                 const auto range = cell_of(layer, i + di, j + dj);
-                for (const Placed* b = range.first; b != range.second; ++b)
-                    for (std::size_t a = g; a < h; ++a) test_neighbours(placed[a], *b, d, out);
+                for (const Placed* b = range.first; b != range.second; ++b) {
+                    if ((b->touches & bit_b) == 0) continue;
+                    for (std::size_t a = g; a < h; ++a)
+                        if ((placed[a].touches & bit_a) != 0) test_neighbours(placed[a], *b, need_a, need_b, out);
+                }
             };
             for (std::size_t a = g; a < h; ++a)
                 for (std::size_t b = a + 1; b < h; ++b) test_pair(placed[a], placed[b], out);

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <random>
 #include <string>
@@ -181,6 +183,59 @@ TEST(ExtractedCheck, FindsTwoVerticesAtOnePosition)
     for (int k = 0; k < 3; ++k) e.mesh.positions[3 * a + static_cast<std::size_t>(k)] = e.mesh.positions[3 * b + static_cast<std::size_t>(k)];
     EXPECT_FALSE(expect_agrees(e.mesh, e.grid())); // welding needs the general check
     EXPECT_GT(mesh_geometry(e.mesh).coincident_vertices, 0);
+}
+
+TEST(ExtractedCheck, FindsAVertexSplitBetweenNeighbouringCells)
+{
+    // the triangles of one cell around an edge's vertex given a copy of it (a mesh not welded
+    // there): the two ids meet only on the contact of neighbouring cells, where the structured
+    // check must see them (the grid's spacing is 1, its origin 0)
+    const Extracted original = noise_mesh();
+    const Mesh& m = original.mesh;
+    const auto cell_of = [&](std::size_t t) {
+        const std::uint32_t* c = &m.triangles[3 * t];
+        std::array<int, 3> cell{};
+        for (std::size_t k = 0; k < 3; ++k)
+            cell[k] = static_cast<int>(std::floor((m.positions[3 * c[0] + k] + m.positions[3 * c[1] + k] + m.positions[3 * c[2] + k]) / 3));
+        return cell;
+    };
+    int split = 0;
+    for (std::size_t t0 = 0; t0 < m.triangle_count() && split < 12; t0 += 97) {
+        const std::uint32_t u = m.triangles[3 * t0];
+        const std::array<int, 3> cell = cell_of(t0);
+        // the copy is vertex u + 1, in u's plane: the ids after it move up by one
+        const std::uint32_t copy = u + 1;
+        Mesh broken = m;
+        broken.positions.clear();
+        for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+            for (std::size_t k = 0; k < 3; ++k) broken.positions.push_back(m.positions[3 * v + k]);
+            if (v == u)
+                for (std::size_t k = 0; k < 3; ++k) broken.positions.push_back(m.positions[3 * v + k]);
+        }
+        broken.normals.clear();
+        bool elsewhere = false; // u stays in a triangle of another cell
+        for (std::size_t t = 0; t < m.triangle_count(); ++t)
+            for (std::size_t q = 0; q < 3; ++q) {
+                const std::uint32_t v = m.triangles[3 * t + q];
+                broken.triangles[3 * t + q] = v > u ? v + 1 : v;
+                if (v != u) continue;
+                if (cell_of(t) == cell) {
+                    broken.triangles[3 * t + q] = copy;
+                } else {
+                    elsewhere = true;
+                }
+            }
+        if (!elsewhere) continue;
+        std::vector<std::int64_t> first_vertex = original.stats.plane_first_vertex;
+        for (auto& f : first_vertex)
+            if (f > static_cast<std::int64_t>(u)) ++f;
+        ExtractedGrid grid = original.grid();
+        grid.plane_first_vertex = first_vertex;
+        SCOPED_TRACE("vertex " + std::to_string(u));
+        EXPECT_FALSE(expect_agrees(broken, grid)); // welding needs the general check
+        ++split;
+    }
+    EXPECT_EQ(split, 12);
 }
 
 TEST(ExtractedCheck, AMeshThatDoesNotFitTheLayoutGetsTheGeneralChecks)
