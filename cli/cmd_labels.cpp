@@ -5,16 +5,14 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <limits>
 #include <memory>
-#include <sstream>
+#include <span>
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/labels.hpp"
@@ -38,43 +36,6 @@ struct LabelsArgs {
     int threads = 0;
     RawVolumeOptions raw;
 };
-
-bool ends_with(const std::string& s, const std::string& tail)
-{
-    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
-}
-
-// Binary little-endian PLY of the interfaces with `front` and `behind` face properties (int, or
-// uint for labels past int32's range).
-void write_interfaces_ply(const LabelSurfaces& s, const std::string& path)
-{
-    bool fits_int = true;
-    for (const std::int64_t l : s.present) {
-        fits_int =
-            fits_int && l >= std::numeric_limits<std::int32_t>::min() && l <= std::numeric_limits<std::int32_t>::max();
-    }
-    const Mesh& m = s.interfaces;
-    io::detail::write_atomically(path, [&](std::ostream& out) {
-        const char* type = fits_int ? "int" : "uint";
-        out << "ply\nformat binary_little_endian 1.0\ncomment cmc33 labels: interface triangles; the normal (counter-"
-               "clockwise winding) points into label `front`\nelement vertex "
-            << m.vertex_count() << "\nproperty float x\nproperty float y\nproperty float z\nelement face "
-            << m.triangle_count() << "\nproperty list uchar int vertex_indices\nproperty " << type
-            << " front\nproperty " << type << " behind\nend_header\n";
-        // little-endian hosts only (as the library's PLY writer): bytes as they are in memory
-        out.write(reinterpret_cast<const char*>(m.positions.data()),
-                  static_cast<std::streamsize>(m.positions.size() * 4));
-        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-            char face[1 + 12 + 8];
-            face[0] = 3;
-            std::memcpy(face + 1, &m.triangles[3 * t], 12);
-            const auto f = static_cast<std::uint32_t>(s.front[t]), b = static_cast<std::uint32_t>(s.behind[t]);
-            std::memcpy(face + 13, &f, 4);
-            std::memcpy(face + 17, &b, 4);
-            out.write(face, sizeof face);
-        }
-    });
-}
 
 /// The colour of the n-th label of a scene: hues a golden angle apart (so that neighbours in the
 /// list differ), saturation 0.6, value 0.9, as linear RGBA.
@@ -103,8 +64,8 @@ void run_labels(const LabelsArgs& args)
     } catch (const Error& e) {
         throw UsageError(std::string("--") + e.what());
     }
-    const bool scene = (ends_with(args.output, ".glb") || ends_with(args.output, ".gltf")) && !fs::is_directory(args.output);
-    const bool single = (scene || ends_with(args.output, ".ply")) && !fs::is_directory(args.output);
+    const bool scene = (args.output.ends_with(".glb") || args.output.ends_with(".gltf")) && !fs::is_directory(args.output);
+    const bool single = (scene || args.output.ends_with(".ply")) && !fs::is_directory(args.output);
     if (single) {
         check_mesh_output(args.output, false, false, {args.input});
     } else {
@@ -131,7 +92,12 @@ void run_labels(const LabelsArgs& args)
         wo.space = volume.space();
         named_step(args.output, "writing the scene", [&] { io::write_scene(parts, args.output, wo); });
     } else if (single) {
-        named_step(args.output, "writing the interfaces", [&] { write_interfaces_ply(s, args.output); });
+        // the labels on the two sides as face properties: int, or uint for labels past int32's range
+        io::MeshWriteOptions wo;
+        wo.space = volume.space();
+        wo.triangle_arrays = {{"front", std::span<const std::int64_t>(s.front), 1},
+                              {"behind", std::span<const std::int64_t>(s.behind), 1}};
+        named_step(args.output, "writing the interfaces", [&] { io::write_mesh(s.interfaces, args.output, wo); });
     } else {
         std::error_code ec;
         fs::create_directory(args.output, ec);

@@ -3,7 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <sys/wait.h>
@@ -50,6 +52,34 @@ TEST(LabelsCli, FolderAndInterfaces)
     EXPECT_EQ(a, test::read_file(dir / "j.ply"));
     EXPECT_NE(a.find("property int front"), std::string::npos);
     EXPECT_EQ(io::read_mesh(dir / "i.ply").triangle_count(), s.interfaces.triangle_count());
+}
+
+TEST(LabelsCli, InterfaceLabelsPastInt32AreUint)
+{
+    // two halves, labels 0 and 3e9 (uint32 samples): the PLY's face properties hold both exactly
+    const fs::path dir = test::temp_dir();
+    Volume seg(ScalarType::u32, {6, 5, 4});
+    std::uint32_t* v = reinterpret_cast<std::uint32_t*>(seg.bytes());
+    for (std::size_t i = 0; i < 6 * 5 * 4; ++i) v[i] = i % 6 < 3 ? 0u : 3000000000u;
+    io::write_volume(seg, dir / "seg.nrrd");
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "i.ply").string(), dir / "err"), 0)
+        << test::read_file(dir / "err");
+    const LabelSurfaces s = label_surfaces(seg);
+    ASSERT_GT(s.interfaces.triangle_count(), 0u);
+    const std::string ply = test::read_file(dir / "i.ply");
+    const std::size_t data = ply.find("end_header\n") + 11;
+    const std::string header = ply.substr(0, data);
+    EXPECT_NE(header.find("property uint " + std::string(s.front[0] == 0 ? "behind" : "front")), std::string::npos)
+        << header;
+    const std::size_t faces = data + 12 * s.interfaces.vertex_count();
+    ASSERT_EQ(ply.size(), faces + 21 * s.interfaces.triangle_count());
+    for (std::size_t t = 0; t < s.interfaces.triangle_count(); ++t) {
+        std::uint32_t front = 0, behind = 0;
+        std::memcpy(&front, ply.data() + faces + 21 * t + 13, 4); // little-endian hosts, as the writer
+        std::memcpy(&behind, ply.data() + faces + 21 * t + 17, 4);
+        ASSERT_EQ(front, s.front[t]) << t;
+        ASSERT_EQ(behind, s.behind[t]) << t;
+    }
 }
 
 TEST(LabelsCli, BadInput)
