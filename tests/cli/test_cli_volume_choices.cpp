@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -38,24 +37,10 @@ std::string ball_npy()
     return bytes + header + ball_samples();
 }
 
-template <class T> void put(std::string& bytes, std::size_t offset, T value)
-{
-    std::memcpy(bytes.data() + offset, &value, sizeof value);
-}
-
 /// A little-endian NIfTI-1 header of the ball (uint8, 8^3); "ni1" for a pair, else "n+1".
 std::string ball_nifti_header(bool pair)
 {
-    std::string bytes(pair ? 348 : 352, '\0');
-    put<std::int32_t>(bytes, 0, 348);
-    const std::int16_t dim[8] = {3, 8, 8, 8, 1, 1, 1, 1};
-    for (std::size_t i = 0; i < 8; ++i) put(bytes, 40 + 2 * i, dim[i]);
-    put<std::int16_t>(bytes, 70, 2); // uint8
-    put<std::int16_t>(bytes, 72, 8);
-    for (std::size_t i = 0; i < 4; ++i) put<float>(bytes, 76 + 4 * i, 1.0f);
-    if (!pair) put<float>(bytes, 108, 352.0f);
-    std::memcpy(bytes.data() + 344, pair ? "ni1\0" : "n+1\0", 4);
-    return bytes;
+    return test::nifti1_header({.dims = {8, 8, 8}, .datatype = 2, .magic = pair ? "ni1" : "n+1"});
 }
 
 std::string info(const fs::path& input, const std::string& more)

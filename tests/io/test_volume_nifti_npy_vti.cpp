@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -12,6 +13,7 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -20,26 +22,12 @@ using cmc33::Status;
 using cmc33::Volume;
 namespace io = cmc33::io;
 
-template <class T> void put(std::string& bytes, std::size_t offset, T value)
-{
-    std::memcpy(bytes.data() + offset, &value, sizeof value);
-}
-
 /// A little-endian single-file NIfTI-1 of 3x3x2 float32 samples (0, 1, 2, ...), sform code 2.
-std::string nifti1(const float srow[3][4], int frames = 1)
+std::string nifti1(const std::array<std::array<float, 4>, 3>& srow, int frames = 1)
 {
-    std::string bytes(352, '\0');
-    put<std::int32_t>(bytes, 0, 348);
-    const std::int16_t dim[8] = {static_cast<std::int16_t>(frames > 1 ? 4 : 3), 3, 3, 2, static_cast<std::int16_t>(frames), 1, 1, 1};
-    for (std::size_t i = 0; i < 8; ++i) put(bytes, 40 + 2 * i, dim[i]);
-    put<std::int16_t>(bytes, 70, 16); // float32
-    put<std::int16_t>(bytes, 72, 32);
-    for (std::size_t i = 0; i < 4; ++i) put<float>(bytes, 76 + 4 * i, 1.0f);
-    put<float>(bytes, 108, 352.0f);
-    put<std::int16_t>(bytes, 254, 2);
-    for (std::size_t r = 0; r < 3; ++r)
-        for (std::size_t c = 0; c < 4; ++c) put<float>(bytes, 280 + 16 * r + 4 * c, srow[r][c]);
-    std::memcpy(bytes.data() + 344, "n+1\0", 4);
+    std::vector<std::int16_t> dims{3, 3, 2};
+    if (frames > 1) dims.push_back(static_cast<std::int16_t>(frames));
+    std::string bytes = cmc33::test::nifti1_header({.dims = dims, .srow = srow});
     for (int i = 0; i < 18 * frames; ++i) {
         const float v = static_cast<float>(i);
         bytes.append(reinterpret_cast<const char*>(&v), 4);
@@ -47,7 +35,8 @@ std::string nifti1(const float srow[3][4], int frames = 1)
     return bytes;
 }
 
-constexpr float kSheared[3][4] = {{0.9f, 0.2f, 0.1f, -40.5f}, {-0.15f, 1.1f, 0.3f, 12.25f}, {0.05f, -0.25f, -1.3f, 7.0f}};
+constexpr std::array<std::array<float, 4>, 3> kSheared{
+    {{0.9f, 0.2f, 0.1f, -40.5f}, {-0.15f, 1.1f, 0.3f, 12.25f}, {0.05f, -0.25f, -1.3f, 7.0f}}};
 
 Volume read_nifti(const std::string& bytes, io::ReadOptions options = {})
 {

@@ -7,7 +7,6 @@
 #include <unistd.h>
 
 #include <cstdint>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -21,23 +20,10 @@ namespace fs = std::filesystem;
 namespace io = cmc33::io;
 using cmc33::Volume;
 
-template <class T> void put(std::string& bytes, std::size_t offset, T value)
-{
-    std::memcpy(bytes.data() + offset, &value, sizeof value);
-}
-
 /// A little-endian NIfTI-1 pair header ("ni1") for 3x3x2 float32 samples, qform and sform unset.
 std::string pair_header()
 {
-    std::string bytes(348, '\0');
-    put<std::int32_t>(bytes, 0, 348);
-    const std::int16_t dim[8] = {3, 3, 3, 2, 1, 1, 1, 1};
-    for (std::size_t i = 0; i < 8; ++i) put(bytes, 40 + 2 * i, dim[i]);
-    put<std::int16_t>(bytes, 70, 16); // float32
-    put<std::int16_t>(bytes, 72, 32);
-    for (std::size_t i = 0; i < 4; ++i) put<float>(bytes, 76 + 4 * i, 1.0f);
-    std::memcpy(bytes.data() + 344, "ni1\0", 4);
-    return bytes;
+    return cmc33::test::nifti1_header({.dims = {3, 3, 2}, .magic = "ni1"});
 }
 
 std::string pair_samples()
@@ -101,10 +87,7 @@ TEST_F(NiftiPair, CompressedPairByEitherFile)
 
 TEST_F(NiftiPair, SingleFilesNameNoDataFile)
 {
-    std::string single = pair_header();
-    std::memcpy(single.data() + 344, "n+1\0", 4);
-    put<float>(single, 108, 352.0f);
-    single += std::string(4, '\0') + pair_samples();
+    const std::string single = cmc33::test::nifti1_header({.dims = {3, 3, 2}}) + pair_samples();
     cmc33::test::write_file(dir_ / "s.nii", single);
     cmc33::test::write_file(dir_ / "s.nii.gz", cmc33::test::gzip_bytes(single));
     for (const char* name : {"s.nii", "s.nii.gz"}) {

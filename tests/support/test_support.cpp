@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -34,6 +35,43 @@ std::string deflate_bytes(const std::string& data, int window_bits)
 }
 
 } // namespace
+
+std::string nifti1_header(const Nifti1Header& header)
+{
+    const bool single = header.magic == "n+1";
+    if (!single && header.magic != "ni1") throw std::invalid_argument("nifti1_header: magic is n+1 or ni1");
+    if (header.dims.empty() || header.dims.size() > 7) throw std::invalid_argument("nifti1_header: 1 to 7 dims");
+    std::int16_t bitpix = 0;
+    switch (header.datatype) { // NIFTI_TYPE_* (nifti1.h) and their sizes in bits
+    case 2:
+    case 256: bitpix = 8; break;
+    case 4:
+    case 512: bitpix = 16; break;
+    case 8:
+    case 16:
+    case 768: bitpix = 32; break;
+    case 64:
+    case 1024:
+    case 1280: bitpix = 64; break;
+    default: throw std::invalid_argument("nifti1_header: a datatype without a size here");
+    }
+    std::string bytes(single ? 352 : 348, '\0');
+    const auto put = [&](std::size_t offset, auto value) { std::memcpy(bytes.data() + offset, &value, sizeof value); };
+    put(0, std::int32_t{348});
+    put(40, static_cast<std::int16_t>(header.dims.size()));
+    for (std::size_t i = 1; i < 8; ++i) put(40 + 2 * i, i <= header.dims.size() ? header.dims[i - 1] : std::int16_t{1});
+    put(70, header.datatype);
+    put(72, bitpix);
+    for (std::size_t i = 0; i < 4; ++i) put(76 + 4 * i, 1.0f); // pixdim[0] (qfac) to pixdim[3]
+    if (single) put(108, 352.0f);                              // vox_offset
+    if (header.srow) {
+        put(254, std::int16_t{2}); // sform_code
+        for (std::size_t r = 0; r < 3; ++r)
+            for (std::size_t c = 0; c < 4; ++c) put(280 + 16 * r + 4 * c, (*header.srow)[r][c]);
+    }
+    std::memcpy(bytes.data() + 344, header.magic.c_str(), 4); // with its terminating zero
+    return bytes;
+}
 
 std::string gzip_bytes(const std::string& data) { return deflate_bytes(data, 31); }
 std::string zlib_bytes(const std::string& data) { return deflate_bytes(data, 15); }

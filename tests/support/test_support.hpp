@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the test executables: temporary folders, the shared volumes, small fields.
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -43,6 +44,18 @@ std::string read_file(const std::filesystem::path& path);
 /// `data` compressed as one gzip stream, or as one zlib stream (for building compressed inputs).
 std::string gzip_bytes(const std::string& data);
 std::string zlib_bytes(const std::string& data);
+
+/// A little-endian NIfTI-1 header (nifti1.h's nifti_1_header), for building inputs. Besides what
+/// is given here: sizeof_hdr 348, pixdim[0..3] 1, qform unset, everything else 0.
+struct Nifti1Header {
+    std::vector<std::int16_t> dims; ///< the sizes (dim[1], dim[2], ...); dim[0] is their count, later dims 1
+    std::int16_t datatype = 16;     ///< a NIFTI_TYPE_* code (16: float32); bitpix follows from it
+    /// "n+1": a single file, 352 bytes (the header and 4 zero extension bytes), vox_offset 352;
+    /// "ni1": the .hdr of a pair, 348 bytes, vox_offset 0
+    std::string magic = "n+1";
+    std::optional<std::array<std::array<float, 4>, 3>> srow{}; ///< sform_code 2 (aligned anatomy) with these rows
+};
+std::string nifti1_header(const Nifti1Header& header);
 
 /// A double volume of the given dims filled by f(i, j, k).
 Volume make_volume(Index3 dims, const std::function<double(std::int64_t, std::int64_t, std::int64_t)>& f,
