@@ -18,17 +18,22 @@ namespace {
 
 bool is_degenerate(std::uint32_t a, std::uint32_t b, std::uint32_t c) { return a == b || b == c || a == c; }
 
+/// Sorts a vertex's ring keys, which are distinct (each holds its slot).
 void sort_keys(std::vector<std::uint64_t>& keys)
 {
-    if (keys.size() > 24) {
+    constexpr std::size_t kSmall = 16;
+    const std::size_t n = keys.size();
+    if (n > kSmall) {
         std::sort(keys.begin(), keys.end());
         return;
     }
-    for (std::size_t i = 1; i < keys.size(); ++i) {
-        const std::uint64_t key = keys[i];
-        std::size_t j = i;
-        for (; j > 0 && keys[j - 1] > key; --j) keys[j] = keys[j - 1];
-        keys[j] = key;
+    // each key's place is the number of smaller keys: no branch to mispredict
+    std::uint64_t in[kSmall];
+    std::copy(keys.begin(), keys.end(), in);
+    for (std::size_t i = 0; i < n; ++i) {
+        std::size_t rank = 0;
+        for (std::size_t j = 0; j < n; ++j) rank += in[j] < in[i] ? 1 : 0;
+        keys[rank] = in[i];
     }
 }
 
