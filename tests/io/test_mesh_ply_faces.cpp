@@ -29,15 +29,9 @@ namespace {
 
 using cmc33::Mesh;
 namespace fs = std::filesystem;
+using cmc33::test::u32_le;
 namespace io = cmc33::io;
 using nlohmann::json;
-
-std::uint32_t u32(const std::string& s, std::size_t at)
-{
-    std::uint32_t v = 0;
-    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(s[at + static_cast<std::size_t>(i)]);
-    return v;
-}
 
 /// Three triangles of a tetrahedron.
 Mesh tetra()
@@ -85,12 +79,12 @@ TEST(MeshPlyFaces, BinaryRecordsHoldTheValues)
         SCOPED_TRACE(f);
         const std::size_t at = data + 4 * 12 + f * face_bytes;
         EXPECT_EQ(bytes[at], 3);
-        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(u32(bytes, at + 1 + 4 * k), m.triangles[3 * f + k]);
-        EXPECT_EQ(std::bit_cast<float>(u32(bytes, at + 13)), kQuality[f]);
-        EXPECT_EQ(static_cast<std::int32_t>(u32(bytes, at + 17)), kRegion[f]);
-        EXPECT_EQ(u32(bytes, at + 21), static_cast<std::uint64_t>(kLabel[f]));
-        EXPECT_EQ(static_cast<std::int32_t>(u32(bytes, at + 25)), kPair[2 * f]);
-        EXPECT_EQ(static_cast<std::int32_t>(u32(bytes, at + 29)), kPair[2 * f + 1]);
+        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(u32_le(bytes, at + 1 + 4 * k), m.triangles[3 * f + k]);
+        EXPECT_EQ(std::bit_cast<float>(u32_le(bytes, at + 13)), kQuality[f]);
+        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 17)), kRegion[f]);
+        EXPECT_EQ(u32_le(bytes, at + 21), static_cast<std::uint64_t>(kLabel[f]));
+        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 25)), kPair[2 * f]);
+        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 29)), kPair[2 * f + 1]);
     }
     // cmc33's reader skips the properties by their declared types: the same mesh
     const Mesh back = io::read_mesh(dir / "b.ply");

@@ -28,19 +28,14 @@ namespace {
 
 using cmc33::Mesh;
 namespace fs = std::filesystem;
+using cmc33::test::u32_le;
 using nlohmann::json;
 
-std::uint32_t u32(const std::string& s, std::size_t at)
-{
-    std::uint32_t v = 0;
-    for (int i = 3; i >= 0; --i) v = (v << 8) | static_cast<unsigned char>(s[at + static_cast<std::size_t>(i)]);
-    return v;
-}
 std::uint64_t u64(const std::string& s, std::size_t at)
 {
-    return u32(s, at) | (std::uint64_t{u32(s, at + 4)} << 32);
+    return u32_le(s, at) | (std::uint64_t{u32_le(s, at + 4)} << 32);
 }
-float f32(const std::string& s, std::size_t at) { return std::bit_cast<float>(u32(s, at)); }
+float f32(const std::string& s, std::size_t at) { return std::bit_cast<float>(u32_le(s, at)); }
 
 /// A tetrahedron with outward normals at its corners (one triangle less: an open mesh is fine here).
 Mesh tetra(bool normals)
@@ -66,18 +61,18 @@ TEST(MeshWriteFormats, GlbChunksAlignedAndJsonComplete)
     cmc33::io::write_mesh(m, dir / "t.glb", options);
     const std::string bytes = cmc33::test::read_file(dir / "t.glb");
     ASSERT_GE(bytes.size(), 20u);
-    EXPECT_EQ(u32(bytes, 0), 0x46546C67u); // "glTF"
-    EXPECT_EQ(u32(bytes, 4), 2u);
-    EXPECT_EQ(u32(bytes, 8), bytes.size());
-    const std::uint32_t json_length = u32(bytes, 12);
-    EXPECT_EQ(u32(bytes, 16), 0x4E4F534Au); // "JSON"
+    EXPECT_EQ(u32_le(bytes, 0), 0x46546C67u); // "glTF"
+    EXPECT_EQ(u32_le(bytes, 4), 2u);
+    EXPECT_EQ(u32_le(bytes, 8), bytes.size());
+    const std::uint32_t json_length = u32_le(bytes, 12);
+    EXPECT_EQ(u32_le(bytes, 16), 0x4E4F534Au); // "JSON"
     EXPECT_EQ(json_length % 4, 0u);
     const std::string text = bytes.substr(20, json_length);
     const json j = json::parse(text); // trailing spaces are JSON whitespace
     const std::size_t bin_at = 20 + json_length;
     ASSERT_EQ(bin_at % 4, 0u);
-    const std::uint32_t bin_length = u32(bytes, bin_at);
-    EXPECT_EQ(u32(bytes, bin_at + 4), 0x004E4942u); // "BIN\0"
+    const std::uint32_t bin_length = u32_le(bytes, bin_at);
+    EXPECT_EQ(u32_le(bytes, bin_at + 4), 0x004E4942u); // "BIN\0"
     EXPECT_EQ(bin_length % 4, 0u);
     EXPECT_EQ(bin_at + 8 + bin_length, bytes.size());
 
@@ -103,7 +98,7 @@ TEST(MeshWriteFormats, GlbChunksAlignedAndJsonComplete)
     const std::size_t p_at = data + j["bufferViews"][pos["bufferView"].get<int>()]["byteOffset"].get<std::size_t>();
     for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(f32(bytes, p_at + 4 * i), m.positions[i]);
     const std::size_t t_at = data + j["bufferViews"][idx["bufferView"].get<int>()]["byteOffset"].get<std::size_t>();
-    for (std::size_t i = 0; i < 9; ++i) EXPECT_EQ(u32(bytes, t_at + 4 * i), m.triangles[i]);
+    for (std::size_t i = 0; i < 9; ++i) EXPECT_EQ(u32_le(bytes, t_at + 4 * i), m.triangles[i]);
 }
 
 TEST(MeshWriteFormats, GlbPartsHaveTheirNodesMeshesAndColours)
@@ -117,8 +112,8 @@ TEST(MeshWriteFormats, GlbPartsHaveTheirNodesMeshesAndColours)
     std::ostringstream out;
     cmc33::io::detail::write_glb(parts, out, {}, "parts.glb");
     const std::string bytes = out.str();
-    ASSERT_EQ(u32(bytes, 8), bytes.size());
-    const json j = json::parse(bytes.substr(20, u32(bytes, 12)));
+    ASSERT_EQ(u32_le(bytes, 8), bytes.size());
+    const json j = json::parse(bytes.substr(20, u32_le(bytes, 12)));
     ASSERT_EQ(j["nodes"].size(), 2u);
     ASSERT_EQ(j["meshes"].size(), 2u);
     ASSERT_EQ(j["materials"].size(), 2u);
@@ -154,8 +149,8 @@ TEST(MeshWriteFormats, EmptyMeshGlbHasNoBuffer)
     const fs::path dir = cmc33::test::temp_dir();
     cmc33::io::write_mesh(Mesh{}, dir / "e.glb");
     const std::string bytes = cmc33::test::read_file(dir / "e.glb");
-    EXPECT_EQ(u32(bytes, 8), bytes.size());
-    EXPECT_EQ(20 + u32(bytes, 12), bytes.size()); // no BIN chunk
+    EXPECT_EQ(u32_le(bytes, 8), bytes.size());
+    EXPECT_EQ(20 + u32_le(bytes, 12), bytes.size()); // no BIN chunk
     const json j = json::parse(bytes.substr(20));
     EXPECT_FALSE(j.contains("buffers"));
     EXPECT_FALSE(j.contains("meshes"));
@@ -222,8 +217,8 @@ TEST(MeshWriteFormats, VtpBlocksInflate)
     EXPECT_EQ(std::memcmp(connectivity.data(), m.triangles.data(), connectivity.size()), 0);
     const std::string offsets = inflate_array(appended, offset_of(xml, "offsets"));
     ASSERT_EQ(offsets.size(), 4u * 50000);
-    EXPECT_EQ(u32(offsets, 0), 3u);
-    EXPECT_EQ(u32(offsets, offsets.size() - 4), 150000u);
+    EXPECT_EQ(u32_le(offsets, 0), 3u);
+    EXPECT_EQ(u32_le(offsets, offsets.size() - 4), 150000u);
     const std::string v = inflate_array(appended, offset_of(xml, "values"));
     ASSERT_EQ(v.size(), 4 * values.size());
     EXPECT_EQ(std::memcmp(v.data(), values.data(), v.size()), 0);

@@ -73,6 +73,13 @@ std::string nifti1_header(const Nifti1Header& header)
     return bytes;
 }
 
+std::uint32_t u32_le(const std::string& bytes, std::size_t at)
+{
+    std::uint32_t v = 0;
+    for (std::size_t i = 4; i-- > 0;) v = (v << 8) | static_cast<unsigned char>(bytes.at(at + i));
+    return v;
+}
+
 std::string gzip_bytes(const std::string& data) { return deflate_bytes(data, 31); }
 std::string zlib_bytes(const std::string& data) { return deflate_bytes(data, 15); }
 

@@ -41,6 +41,9 @@ std::filesystem::path run_writer(const std::string& python, const std::string& s
 void write_file(const std::filesystem::path& path, const std::string& bytes);
 std::string read_file(const std::filesystem::path& path);
 
+/// The little-endian uint32 at byte `at` of `bytes` (for checking written files).
+std::uint32_t u32_le(const std::string& bytes, std::size_t at);
+
 /// `data` compressed as one gzip stream, or as one zlib stream (for building compressed inputs).
 std::string gzip_bytes(const std::string& data);
 std::string zlib_bytes(const std::string& data);
