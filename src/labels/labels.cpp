@@ -5,15 +5,16 @@
 #include "cmc33/labels.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <limits>
-#include <mutex>
 #include <string>
-#include <unordered_map>
 #include <unordered_set>
+#include <vector>
 
 #include "cmc33/cell.hpp"
 #include "cmc33/error.hpp"
+#include "parallel.hpp"
 
 namespace cmc33 {
 
@@ -79,94 +80,59 @@ const std::array<Pattern, 256>& patterns()
     return table;
 }
 
-struct Triangle {
-    std::array<std::uint32_t, 3> v;
-    std::int64_t front, behind;
-};
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-class Builder {
+// World coordinates of grid indices: origin + M * index. Without rotation M is diagonal and the
+// zero products are skipped (they add nothing).
+class Placer {
 public:
-    Builder(const Index3& dims, const Vec3& spacing, const Vec3& origin, const Mat3& direction,
-            const std::vector<std::int64_t>& selected)
-        : dims_(dims), m_(frame_matrix(spacing, direction)), origin_(origin), selected_(selected)
+    Placer(const Vec3& spacing, const Vec3& origin, const Mat3& direction)
+        : m_(frame_matrix(spacing, direction)), origin_(origin)
     {
-        for (std::size_t a = 0; a < 3; ++a) span_[a] = static_cast<std::uint64_t>(2 * dims[a] - 1);
-        interior_base_ = span_[0] * span_[1] * span_[2];
+        diagonal_ = m_[0][1] == 0 && m_[0][2] == 0 && m_[1][0] == 0 && m_[1][2] == 0 && m_[2][0] == 0 &&
+                    m_[2][1] == 0;
     }
-
-    bool wanted(std::int64_t a, std::int64_t b) const
+    void put(Buffer<float>& out, double x, double y, double z) const
     {
-        return std::binary_search(selected_.begin(), selected_.end(), a) ||
-               std::binary_search(selected_.begin(), selected_.end(), b);
-    }
-
-    // The vertex at doubled grid coordinates (X, Y, Z), made on first use.
-    std::uint32_t grid_vertex(std::int64_t x, std::int64_t y, std::int64_t z)
-    {
-        const std::uint64_t key = static_cast<std::uint64_t>(x) +
-                                  span_[0] * (static_cast<std::uint64_t>(y) + span_[1] * static_cast<std::uint64_t>(z));
-        return vertex(key, {0.5 * static_cast<double>(x), 0.5 * static_cast<double>(y), 0.5 * static_cast<double>(z)});
-    }
-
-    // Interior point `slot` of cmc33's triangulation of cell (i, j, k).
-    std::uint32_t interior_vertex(std::int64_t i, std::int64_t j, std::int64_t k, int slot,
-                                  const std::array<double, 3>& unit)
-    {
-        const auto n = [&](std::size_t a) { return static_cast<std::uint64_t>(dims_[a] - 1); };
-        const std::uint64_t cell = static_cast<std::uint64_t>(i) +
-                                   n(0) * (static_cast<std::uint64_t>(j) + n(1) * static_cast<std::uint64_t>(k));
-        const std::uint64_t key = interior_base_ + kInteriorSlots * cell + static_cast<std::uint64_t>(slot);
-        return vertex(key, {static_cast<double>(i) + unit[0], static_cast<double>(j) + unit[1],
-                            static_cast<double>(k) + unit[2]});
-    }
-
-    void add(const std::array<std::uint32_t, 3>& v, std::int64_t front, std::int64_t behind)
-    {
-        triangles_.push_back(Triangle{v, front, behind});
-    }
-
-    LabelSurfaces finish(LabelSurfaces out)
-    {
-        const bool flip = determinant(m_) < 0; // a mirroring frame reverses every winding
-        out.interfaces.positions = std::move(positions_);
-        out.interfaces.triangles.reserve(3 * triangles_.size());
-        out.front.reserve(triangles_.size());
-        out.behind.reserve(triangles_.size());
-        for (const Triangle& t : triangles_) {
-            out.interfaces.triangles.push_back(t.v[0]);
-            out.interfaces.triangles.push_back(flip ? t.v[2] : t.v[1]);
-            out.interfaces.triangles.push_back(flip ? t.v[1] : t.v[2]);
-            out.front.push_back(t.front);
-            out.behind.push_back(t.behind);
+        if (diagonal_) {
+            out.push_back(static_cast<float>(origin_[0] + m_[0][0] * x));
+            out.push_back(static_cast<float>(origin_[1] + m_[1][1] * y));
+            out.push_back(static_cast<float>(origin_[2] + m_[2][2] * z));
+            return;
         }
-        return out;
+        for (std::size_t r = 0; r < 3; ++r) {
+            out.push_back(static_cast<float>(origin_[r] + m_[r][0] * x + m_[r][1] * y + m_[r][2] * z));
+        }
     }
+    bool mirrors() const { return determinant(m_) < 0; }
 
 private:
-    std::uint32_t vertex(std::uint64_t key, const std::array<double, 3>& index)
-    {
-        const auto [it, added] = map_.try_emplace(key, static_cast<std::uint32_t>(positions_.size() / 3));
-        if (added) {
-            if (positions_.size() / 3 >= std::numeric_limits<std::uint32_t>::max()) {
-                throw Error(Status::too_large, "the label surfaces have more than 4294967295 vertices");
-            }
-            for (std::size_t r = 0; r < 3; ++r) {
-                positions_.push_back(
-                    static_cast<float>(origin_[r] + m_[r][0] * index[0] + m_[r][1] * index[1] + m_[r][2] * index[2]));
-            }
-        }
-        return it->second;
-    }
-
-    Index3 dims_;
     Mat3 m_;
     Vec3 origin_;
-    const std::vector<std::int64_t>& selected_;
-    std::array<std::uint64_t, 3> span_{};
-    std::uint64_t interior_base_ = 0;
-    std::unordered_map<std::uint64_t, std::uint32_t> map_;
-    Buffer<float> positions_;
-    std::vector<Triangle> triangles_;
+    bool diagonal_ = false;
+};
+
+// Whether a label gets a surface (the selection's rule, applied to any value).
+struct Chooser {
+    const LabelOptions& options;
+    bool operator()(std::int64_t v) const
+    {
+        if (options.labels.empty()) return v != options.background;
+        return std::any_of(options.labels.begin(), options.labels.end(),
+                           [&](const auto& r) { return r[0] <= v && v <= r[1]; });
+    }
+    bool wanted(std::int64_t a, std::int64_t b) const { return (*this)(a) || (*this)(b); }
+};
+
+// One z-range of cell layers [k0, k1): its vertices numbered from 0 in order of first use, and the
+// ids of its vertices on its first and last planes (z = k0 and z = k1), to weld the ranges.
+struct Part {
+    Buffer<float> positions;
+    Buffer<std::uint32_t> triangles;
+    std::vector<std::int64_t> front, behind;
+    std::vector<std::array<std::uint32_t, 2>> bottom, top; ///< (index in the plane, vertex id)
+    std::unordered_set<std::int64_t> present;
+    std::int64_t cells_two_labels = 0, cells_many_labels = 0;
 };
 
 using Doubled = std::array<int, 3>;
@@ -238,78 +204,258 @@ template <class Emit> void many_label_cell(const std::array<std::int64_t, 8>& la
     }
 }
 
+// Every label of a grid too thin to have cells.
+template <class T> std::vector<std::int64_t> scan_present(const GridView<T>& g)
+{
+    std::unordered_set<std::int64_t> seen;
+    for (std::int64_t k = 0; k < g.nz(); ++k)
+        for (std::int64_t j = 0; j < g.ny(); ++j)
+            for (std::int64_t i = 0; i < g.nx(); ++i) seen.insert(static_cast<std::int64_t>(g(i, j, k)));
+    std::vector<std::int64_t> out(seen.begin(), seen.end());
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+// The cell pass over layers [k0, k1). Vertices at doubled grid coordinates are found through three
+// planes of ids (doubled z = 2k, 2k + 1, 2k + 2), reset through the lists of the entries they set;
+// cmc33's interior points belong to one cell and are numbered within it.
+template <class T> class Worker {
+public:
+    Worker(const GridView<T>& g, const Placer& place, const Chooser& chosen, Part& out)
+        : g_(g), place_(place), chosen_(chosen), flip_(place.mirrors()), out_(out),
+          span0_(static_cast<std::size_t>(2 * g.nx() - 1))
+    {
+        const std::size_t plane = span0_ * static_cast<std::size_t>(2 * g.ny() - 1);
+        for (auto& p : planes_) p.assign(plane, kNone);
+    }
+
+    void layers(std::int64_t k0, std::int64_t k1)
+    {
+        const auto& table = patterns();
+        const std::int64_t sx = g_.strides[0];
+        std::array<std::int64_t, 8> label{};
+        std::int64_t last = 0;
+        bool any = false;
+        const auto note = [&](std::int64_t v) {
+            if (any && v == last) return;
+            any = true;
+            last = v;
+            out_.present.insert(v);
+        };
+        for (std::int64_t k = k0; k < k1; ++k) {
+            for (std::int64_t j = 0; j + 1 < g_.ny(); ++j) {
+                const std::array<const T*, 4> row{g_.data + g_.offset(0, j, k), g_.data + g_.offset(0, j + 1, k),
+                                                  g_.data + g_.offset(0, j, k + 1),
+                                                  g_.data + g_.offset(0, j + 1, k + 1)};
+                for (std::int64_t i = 0; i + 1 < g_.nx(); ++i) {
+                    std::array<T, 8> s;
+                    bool uniform = true;
+                    for (unsigned c = 0; c < 8; ++c) {
+                        s[c] = row[c >> 1][(i + (c & 1U)) * sx];
+                        uniform = uniform && s[c] == s[0];
+                    }
+                    if (uniform) {
+                        note(static_cast<std::int64_t>(s[0]));
+                        continue;
+                    }
+                    for (unsigned c = 0; c < 8; ++c) {
+                        label[c] = static_cast<std::int64_t>(s[c]);
+                        note(label[c]);
+                    }
+                    cell(table, label, i, j, k);
+                }
+            }
+            if (k == k0) out_.bottom = ids(0);
+            // the plane z = k + 1 becomes the next layer's first
+            reset(0);
+            reset(1);
+            std::swap(planes_[0], planes_[2]);
+            std::swap(touched_[0], touched_[2]);
+        }
+        out_.top = ids(0);
+    }
+
+private:
+    void cell(const std::array<Pattern, 256>& table, const std::array<std::int64_t, 8>& label, std::int64_t i,
+              std::int64_t j, std::int64_t k)
+    {
+        std::int64_t low = label[0], high = label[0];
+        for (const std::int64_t l : label) {
+            low = std::min(low, l);
+            high = std::max(high, l);
+        }
+        bool two = true;
+        for (const std::int64_t l : label) two = two && (l == low || l == high);
+        const auto at = [&](const Doubled& d) {
+            return grid_vertex(2 * i + d[0], 2 * j + d[1], 2 * k + d[2], static_cast<std::size_t>(d[2]));
+        };
+        if (two) {
+            ++out_.cells_two_labels;
+            if (!chosen_.wanted(low, high)) return;
+            unsigned config = 0;
+            for (unsigned c = 0; c < 8; ++c) config |= (label[c] == low ? 1U : 0U) << c;
+            std::array<std::uint32_t, kInteriorSlots> interior;
+            interior.fill(kNone);
+            for (const auto& tri : table[config].triangles) {
+                std::array<std::uint32_t, 3> v{};
+                for (std::size_t n = 0; n < 3; ++n) {
+                    const TableVertex& t = tri[n];
+                    if (!t.interior) {
+                        v[n] = at(t.doubled);
+                        continue;
+                    }
+                    std::uint32_t& id = interior[static_cast<std::size_t>(t.slot)];
+                    if (id == kNone) {
+                        id = new_vertex(static_cast<double>(i) + t.unit[0], static_cast<double>(j) + t.unit[1],
+                                        static_cast<double>(k) + t.unit[2]);
+                    }
+                    v[n] = id;
+                }
+                // cmc33's normals point from above (the lower label) to below
+                add(v, high, low);
+            }
+            return;
+        }
+        ++out_.cells_many_labels;
+        many_label_cell(label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front,
+                                   std::int64_t behind) {
+            if (chosen_.wanted(front, behind)) add({at(a), at(b), at(c)}, front, behind);
+        });
+    }
+
+    std::uint32_t grid_vertex(std::int64_t x, std::int64_t y, std::int64_t z, std::size_t plane)
+    {
+        const std::size_t at = static_cast<std::size_t>(x) + span0_ * static_cast<std::size_t>(y);
+        std::uint32_t& id = planes_[plane][at];
+        if (id == kNone) {
+            id = new_vertex(0.5 * static_cast<double>(x), 0.5 * static_cast<double>(y), 0.5 * static_cast<double>(z));
+            touched_[plane].push_back(static_cast<std::uint32_t>(at));
+        }
+        return id;
+    }
+
+    std::uint32_t new_vertex(double x, double y, double z)
+    {
+        const std::size_t n = out_.positions.size() / 3;
+        if (n >= kNone) throw Error(Status::too_large, "the label surfaces have more than 4294967295 vertices");
+        place_.put(out_.positions, x, y, z);
+        return static_cast<std::uint32_t>(n);
+    }
+
+    void add(const std::array<std::uint32_t, 3>& v, std::int64_t front, std::int64_t behind)
+    {
+        // a mirroring frame reverses every winding
+        out_.triangles.push_back(v[0]);
+        out_.triangles.push_back(flip_ ? v[2] : v[1]);
+        out_.triangles.push_back(flip_ ? v[1] : v[2]);
+        out_.front.push_back(front);
+        out_.behind.push_back(behind);
+    }
+
+    std::vector<std::array<std::uint32_t, 2>> ids(std::size_t plane) const
+    {
+        std::vector<std::array<std::uint32_t, 2>> out;
+        out.reserve(touched_[plane].size());
+        for (const std::uint32_t at : touched_[plane]) out.push_back({at, planes_[plane][at]});
+        return out;
+    }
+
+    void reset(std::size_t plane)
+    {
+        for (const std::uint32_t at : touched_[plane]) planes_[plane][at] = kNone;
+        touched_[plane].clear();
+    }
+
+    const GridView<T>& g_;
+    const Placer& place_;
+    const Chooser& chosen_;
+    bool flip_;
+    Part& out_;
+    std::size_t span0_;
+    std::array<std::vector<std::uint32_t>, 3> planes_;
+    std::array<std::vector<std::uint32_t>, 3> touched_;
+};
+
+// The parts joined in order: a part's vertices on its first plane that the part below made take
+// that part's ids, every other vertex the next id. That is the numbering one range would give.
+void weld(std::vector<Part>& parts, std::size_t plane, LabelSurfaces& out)
+{
+    Mesh& mesh = out.interfaces;
+    if (parts.size() == 1) {
+        mesh.positions = std::move(parts[0].positions);
+        mesh.triangles = std::move(parts[0].triangles);
+        out.front = std::move(parts[0].front);
+        out.behind = std::move(parts[0].behind);
+        return;
+    }
+    std::size_t vertices = 0, triangles = 0;
+    for (const Part& p : parts) {
+        vertices += p.positions.size();
+        triangles += p.triangles.size();
+    }
+    mesh.positions.reserve(vertices);
+    mesh.triangles.reserve(triangles);
+    out.front.reserve(triangles / 3);
+    out.behind.reserve(triangles / 3);
+    std::vector<std::uint32_t> boundary(plane, kNone), remap;
+    std::uint64_t next = 0;
+    for (std::size_t r = 0; r < parts.size(); ++r) {
+        Part& p = parts[r];
+        remap.assign(p.positions.size() / 3, kNone);
+        if (r > 0) {
+            for (const auto& [at, id] : p.bottom) remap[id] = boundary[at];
+            for (const auto& [at, id] : parts[r - 1].top) boundary[at] = kNone;
+        }
+        for (std::size_t v = 0; v < remap.size(); ++v) {
+            if (remap[v] != kNone) continue;
+            if (next >= kNone) throw Error(Status::too_large, "the label surfaces have more than 4294967295 vertices");
+            remap[v] = static_cast<std::uint32_t>(next++);
+            mesh.positions.insert(mesh.positions.end(), p.positions.begin() + static_cast<std::ptrdiff_t>(3 * v),
+                                  p.positions.begin() + static_cast<std::ptrdiff_t>(3 * v + 3));
+        }
+        for (const auto& [at, id] : p.top) boundary[at] = remap[id];
+        for (const std::uint32_t v : p.triangles) mesh.triangles.push_back(remap[v]);
+        out.front.insert(out.front.end(), p.front.begin(), p.front.end());
+        out.behind.insert(out.behind.end(), p.behind.begin(), p.behind.end());
+        Buffer<float>().swap(p.positions); // each part freed once copied
+        Buffer<std::uint32_t>().swap(p.triangles);
+    }
+}
+
 template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
 {
     LabelSurfaces out;
-    // every label present, for the selection
-    {
-        std::unordered_set<std::int64_t> seen;
-        bool any = false;
-        T last{};
-        for (std::int64_t k = 0; k < g.nz(); ++k)
-            for (std::int64_t j = 0; j < g.ny(); ++j)
-                for (std::int64_t i = 0; i < g.nx(); ++i) {
-                    const T v = g(i, j, k);
-                    if (any && v == last) continue;
-                    any = true;
-                    last = v;
-                    seen.insert(static_cast<std::int64_t>(v));
-                }
-        out.present.assign(seen.begin(), seen.end());
+    const Chooser chosen{options};
+    const Placer place(g.spacing, g.origin, g.direction);
+    if (g.nx() < 2 || g.ny() < 2 || g.nz() < 2) {
+        out.present = scan_present(g);
+    } else {
+        // z-ranges of cell layers, one per thread; the output does not depend on how many
+        const std::int64_t layers = g.nz() - 1;
+        const int threads = static_cast<int>(std::min<std::int64_t>(detail::resolve_threads(options.threads), layers));
+        std::vector<Part> parts(static_cast<std::size_t>(threads));
+        detail::parallel_chunks(layers, threads, [&](int t, std::int64_t k0, std::int64_t k1) {
+            Worker<T> worker(g, place, chosen, parts[static_cast<std::size_t>(t)]);
+            worker.layers(k0, k1);
+        });
+        std::unordered_set<std::int64_t> present;
+        for (Part& p : parts) {
+            present.insert(p.present.begin(), p.present.end());
+            out.cells_two_labels += p.cells_two_labels;
+            out.cells_many_labels += p.cells_many_labels;
+        }
+        out.present.assign(present.begin(), present.end());
         std::sort(out.present.begin(), out.present.end());
+        weld(parts, static_cast<std::size_t>((2 * g.nx() - 1) * (2 * g.ny() - 1)), out);
     }
     for (const std::int64_t v : out.present) {
-        const bool chosen = options.labels.empty() ? v != options.background
-                                                   : std::any_of(options.labels.begin(), options.labels.end(),
-                                                                 [&](const auto& r) { return r[0] <= v && v <= r[1]; });
-        if (chosen) out.selected.push_back(v);
+        if (chosen(v)) out.selected.push_back(v);
     }
-    Builder builder(g.dims, g.spacing, g.origin, g.direction, out.selected);
-    if (g.nx() < 2 || g.ny() < 2 || g.nz() < 2 || out.selected.empty()) return builder.finish(std::move(out));
-    const auto& table = patterns();
-    std::array<std::int64_t, 8> label{};
-    for (std::int64_t k = 0; k + 1 < g.nz(); ++k)
-        for (std::int64_t j = 0; j + 1 < g.ny(); ++j)
-            for (std::int64_t i = 0; i + 1 < g.nx(); ++i) {
-                bool uniform = true;
-                for (unsigned c = 0; c < 8; ++c) {
-                    label[c] = static_cast<std::int64_t>(g(i + (c & 1U), j + (c >> 1 & 1U), k + (c >> 2 & 1U)));
-                    uniform = uniform && label[c] == label[0];
-                }
-                if (uniform) continue;
-                std::int64_t low = label[0], high = label[0];
-                for (const std::int64_t l : label) {
-                    low = std::min(low, l);
-                    high = std::max(high, l);
-                }
-                bool two = true;
-                for (const std::int64_t l : label) two = two && (l == low || l == high);
-                const auto at = [&](const Doubled& d) {
-                    return builder.grid_vertex(2 * i + d[0], 2 * j + d[1], 2 * k + d[2]);
-                };
-                if (two) {
-                    ++out.cells_two_labels;
-                    if (!builder.wanted(low, high)) continue;
-                    unsigned config = 0;
-                    for (unsigned c = 0; c < 8; ++c) config |= (label[c] == low ? 1U : 0U) << c;
-                    for (const auto& tri : table[config].triangles) {
-                        std::array<std::uint32_t, 3> v{};
-                        for (std::size_t n = 0; n < 3; ++n) {
-                            v[n] = tri[n].interior ? builder.interior_vertex(i, j, k, tri[n].slot, tri[n].unit)
-                                                   : at(tri[n].doubled);
-                        }
-                        // cmc33's normals point from above (the lower label) to below
-                        builder.add(v, high, low);
-                    }
-                    continue;
-                }
-                ++out.cells_many_labels;
-                many_label_cell(label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front,
-                                           std::int64_t behind) {
-                    if (builder.wanted(front, behind)) builder.add({at(a), at(b), at(c)}, front, behind);
-                });
-            }
-    return builder.finish(std::move(out));
+    if (out.selected.empty()) {
+        // nothing selected: no cell was triangulated, none counted
+        out.cells_two_labels = out.cells_many_labels = 0;
+    }
+    return out;
 }
 
 std::int64_t parse_value(std::string_view text, std::string_view whole)

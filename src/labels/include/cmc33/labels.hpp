@@ -34,6 +34,8 @@ struct LabelOptions {
     std::int64_t background = 0;
     /// The labels that get surfaces; empty: every label present except `background`.
     LabelRanges labels{};
+    /// Threads of the cell pass (z-ranges); 0: all cores. The output is the same for every count.
+    int threads = 0;
 };
 
 /// The interfaces of a label map, in world coordinates as extract() places vertices (the volume's
