@@ -59,6 +59,7 @@ void run_labels(const LabelsArgs& args)
 {
     LabelOptions options;
     options.background = args.background;
+    options.threads = args.threads;
     try {
         options.labels = parse_label_ranges(args.labels);
     } catch (const Error& e) {
@@ -172,7 +173,7 @@ void add_labels(CLI::App& app)
         ->check(CLI::IsMember({"ply", "obj", "stl", "off", "glb", "gltf", "vtp", "gii"}));
     cmd->add_flag("--json", args->json, "Print one JSON object: every label's file, size, topology and embedding");
     cmd->add_option("--threads", args->threads,
-                    "Worker threads of the --json checks, 0 = all cores (the surfaces: one)")
+                    "Threads of the surfaces and the --json checks, 0 = all cores (the same files for any count)")
         ->type_name("N")
         ->check(thread_count());
     add_raw_volume_options(*cmd, args->raw);
