@@ -89,8 +89,7 @@ public:
     Placer(const Vec3& spacing, const Vec3& origin, const Mat3& direction)
         : m_(frame_matrix(spacing, direction)), origin_(origin)
     {
-        diagonal_ = m_[0][1] == 0 && m_[0][2] == 0 && m_[1][0] == 0 && m_[1][2] == 0 && m_[2][0] == 0 &&
-                    m_[2][1] == 0;
+        diagonal_ = m_[0][1] == 0 && m_[0][2] == 0 && m_[1][0] == 0 && m_[1][2] == 0 && m_[2][0] == 0 && m_[2][1] == 0;
     }
     void put(Buffer<float>& out, double x, double y, double z) const
     {
@@ -317,10 +316,10 @@ private:
             return;
         }
         ++out_.cells_many_labels;
-        many_label_cell(label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front,
-                                   std::int64_t behind) {
-            if (chosen_.wanted(front, behind)) add({at(a), at(b), at(c)}, front, behind);
-        });
+        many_label_cell(
+            label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front, std::int64_t behind) {
+                if (chosen_.wanted(front, behind)) add({at(a), at(b), at(c)}, front, behind);
+            });
     }
 
     std::uint32_t grid_vertex(std::int64_t x, std::int64_t y, std::int64_t z, std::size_t plane)

@@ -89,8 +89,7 @@ void expect_same(const LabelSurfaces& a, const LabelSurfaces& b, const std::stri
 {
     ASSERT_EQ(a.interfaces.positions.size(), b.interfaces.positions.size()) << what;
     EXPECT_EQ(
-        std::memcmp(a.interfaces.positions.data(), b.interfaces.positions.data(), a.interfaces.positions.size() * 4),
-        0)
+        std::memcmp(a.interfaces.positions.data(), b.interfaces.positions.data(), a.interfaces.positions.size() * 4), 0)
         << what;
     EXPECT_TRUE(a.interfaces.triangles == b.interfaces.triangles) << what;
     EXPECT_EQ(a.front, b.front) << what;
