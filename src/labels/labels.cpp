@@ -527,18 +527,39 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
     Mesh out;
     // an unselected label's interfaces with other unselected labels were not made
     if (!std::binary_search(surfaces.selected.begin(), surfaces.selected.end(), label)) return out;
-    std::vector<std::uint32_t> remap(all.vertex_count(), std::numeric_limits<std::uint32_t>::max());
+    std::vector<std::size_t> mine;
+    for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+        if (surfaces.front[t] == label || surfaces.behind[t] == label) mine.push_back(t);
+    }
+    out.triangles.reserve(3 * mine.size());
+    const std::size_t most = std::min(all.vertex_count(), 3 * mine.size());
+    out.positions.reserve(3 * most);
+    // vertices numbered in order of first use, through an array over all vertices, or for a label
+    // with few of them (one of many) through the sorted list of those it uses
+    std::vector<std::uint32_t> used, remap;
+    const bool few = 16 * most < all.vertex_count();
+    if (few) {
+        used.reserve(3 * mine.size());
+        for (const std::size_t t : mine) used.insert(used.end(), &all.triangles[3 * t], &all.triangles[3 * t] + 3);
+        std::sort(used.begin(), used.end());
+        used.erase(std::unique(used.begin(), used.end()), used.end());
+        remap.assign(used.size(), kNone);
+    } else {
+        remap.assign(all.vertex_count(), kNone);
+    }
     const auto use = [&](std::uint32_t v) {
-        if (remap[v] == std::numeric_limits<std::uint32_t>::max()) {
-            remap[v] = static_cast<std::uint32_t>(out.positions.size() / 3);
+        std::uint32_t& id =
+            few ? remap[static_cast<std::size_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin())]
+                : remap[v];
+        if (id == kNone) {
+            id = static_cast<std::uint32_t>(out.positions.size() / 3);
             for (std::size_t a = 0; a < 3; ++a) out.positions.push_back(all.positions[3 * v + a]);
         }
-        out.triangles.push_back(remap[v]);
+        out.triangles.push_back(id);
     };
-    for (std::size_t t = 0; t < all.triangle_count(); ++t) {
-        const bool in_front = surfaces.front[t] == label;
-        if (!in_front && surfaces.behind[t] != label) continue;
+    for (const std::size_t t : mine) {
         // normals point into `front`; the label's surface points out of it
+        const bool in_front = surfaces.front[t] == label;
         use(all.triangles[3 * t]);
         use(all.triangles[3 * t + (in_front ? 2 : 1)]);
         use(all.triangles[3 * t + (in_front ? 1 : 2)]);
