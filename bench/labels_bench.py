@@ -208,25 +208,31 @@ def table(records, cases, meta, notes):
     def secs(r):
         return f"{r['seconds']:.2f}" if r else "–"
 
-    def ratio(a, b):
-        return f"{a['seconds'] / b['seconds']:.2f}" if a and b and b["seconds"] > 0 else "–"
+    def ratio(a, b, key="seconds"):
+        return f"{a[key] / b[key]:.2f}" if a and b and b[key] > 0 else "–"
 
     lines = ["# Label maps: whole processes, read -> surfaces -> files", "",
              f"- date: {meta['date']}; machine: {meta['cpu']}, {meta['nproc']} logical CPUs",
              f"- commit {meta['commit']}, {meta['compiler']}, Release; one run each, wall time", "",
              "| case (labels) | labels 1 thr s | labels s | VTK 1 thr s | VTK s | extract 1 thr s | extract s | "
-             "labels / VTK, 1 thr / all (≤ 0.5) | labels / extract, 1 thr / all (≤ 3) |",
-             "|---|--:|--:|--:|--:|--:|--:|--:|--:|"]
+             "labels / VTK, 1 thr / all (≤ 0.5) | labels / extract, 1 thr / all (≤ 3) | "
+             "CPU s labels / VTK / extract, 1 thr | CPU labels / VTK, labels / extract, 1 thr |",
+             "|---|--:|--:|--:|--:|--:|--:|--:|--:|--:|--:|"]
     for name in cases:
         r = {t: find(name, t) for t in TOOLS}
         count = next((x["labels"] for x in records if x["case"] == name), 0)
         lines.append(f"| {name} ({count}) | " + " | ".join(secs(r[t]) for t in TOOLS) +
                      f" | {ratio(r['labels-1'], r['vtk-1'])} / {ratio(r['labels'], r['vtk'])}"
-                     f" | {ratio(r['labels-1'], r['extract-1'])} / {ratio(r['labels'], r['extract'])} |")
+                     f" | {ratio(r['labels-1'], r['extract-1'])} / {ratio(r['labels'], r['extract'])} | "
+                     + " / ".join(f"{r[t]['cpu_seconds']:.2f}" if r[t] else "–"
+                                  for t in ("labels-1", "vtk-1", "extract-1"))
+                     + f" | {ratio(r['labels-1'], r['vtk-1'], 'cpu_seconds')}, "
+                     f"{ratio(r['labels-1'], r['extract-1'], 'cpu_seconds')} |")
     lines += ["", "labels: `cmc33 labels SEG -o DIR` (one binary PLY per label but 0, no normals); VTK: "
               "vtkNrrdReader -> vtkDiscreteFlyingEdges3D (every label but 0, ComputeNormals) -> vtkPLYWriter "
               "(binary, one file) in python3; extract: `cmc33 extract SEG --iso 0.5 --normals -o out.ply` "
-              "(the foreground). 1 thr: `--threads 1`, vtkSMPTools.Initialize(1)."]
+              "(the foreground). 1 thr: `--threads 1`, vtkSMPTools.Initialize(1). CPU s: user + system time of the "
+              "process; on a loaded machine it varies less than the wall time."]
     notes = notes + [f"failed: {r['case']}, {r['tool']}: {r['error']}" for r in records if "error" in r]
     if notes:
         lines += ["", "Notes:", ""] + [f"- {n}" for n in notes]
