@@ -265,6 +265,7 @@ public:
                 }
             }
             if (k == k0) out_.bottom = ids(0);
+            reserve_ahead(k + 1 - k0, k1 - k0);
             // the plane z = k + 1 becomes the next layer's first
             reset(0);
             reset(1);
@@ -320,6 +321,20 @@ private:
             label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front, std::int64_t behind) {
                 if (chosen_.wanted(front, behind)) add({at(a), at(b), at(c)}, front, behind);
             });
+    }
+
+    // Room for the range at the rate of its layers so far (a quarter more), once that passes the
+    // capacity: fewer regrowths, each of which copies the arrays and touches fresh pages.
+    void reserve_ahead(std::int64_t done, std::int64_t all)
+    {
+        const auto ahead = [&](auto& v) {
+            const std::size_t need = v.size() / static_cast<std::size_t>(done) * static_cast<std::size_t>(all);
+            if (need > v.capacity()) v.reserve(need + need / 4);
+        };
+        ahead(out_.positions);
+        ahead(out_.triangles);
+        ahead(out_.front);
+        ahead(out_.behind);
     }
 
     std::uint32_t grid_vertex(std::int64_t x, std::int64_t y, std::int64_t z, std::size_t plane)
