@@ -6,9 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <limits>
 #include <random>
 #include <string>
@@ -17,7 +14,6 @@
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
-#include "portability.hpp"
 #include "test_support.hpp"
 
 namespace {
@@ -173,92 +169,6 @@ TEST(Extract, ReusedMeshBlocksHoldNoTraceOfTheirLastMesh)
     EXPECT_EQ(first.positions, again.positions);
     EXPECT_EQ(first.normals, again.normals);
     EXPECT_EQ(first.triangles, again.triangles);
-}
-
-TEST(Extract, BlocksPastSixteenMiBAreKeptForTheNextOfTheirSizeClass)
-{
-    // src/base/buffer.cpp: a block of more than 16 MiB is kept when freed and given to the next
-    // request of its size class (the next eighth of its power of two); a request of another
-    // class releases the kept blocks and gets a new one
-    using cmc33::detail::allocate_buffer;
-    using cmc33::detail::deallocate_buffer;
-    constexpr std::size_t kMiB = std::size_t{1} << 20;
-    void* first = allocate_buffer(40 * kMiB);
-    static_cast<char*>(first)[40 * kMiB - 1] = 1;
-    deallocate_buffer(first, 40 * kMiB);
-    void* again = allocate_buffer(37 * kMiB); // the same class (36 to 40 MiB)
-    EXPECT_EQ(again, first);
-    void* other = allocate_buffer(41 * kMiB); // the next class, while `again` is in use
-    EXPECT_NE(other, again);
-    static_cast<char*>(other)[41 * kMiB - 1] = 2;
-    deallocate_buffer(again, 37 * kMiB);
-    deallocate_buffer(other, 41 * kMiB);
-    void* both[2] = {allocate_buffer(38 * kMiB), allocate_buffer(43 * kMiB)};
-    EXPECT_EQ(both[0], first);
-    EXPECT_EQ(both[1], other);
-    deallocate_buffer(both[0], 38 * kMiB);
-    deallocate_buffer(both[1], 43 * kMiB);
-    void* large = allocate_buffer(100 * kMiB); // no class kept: both released, a new block
-    EXPECT_NE(large, nullptr);
-    static_cast<char*>(large)[100 * kMiB - 1] = 3;
-    deallocate_buffer(large, 100 * kMiB);
-    EXPECT_EQ(allocate_buffer(100 * kMiB), large);
-    deallocate_buffer(large, 100 * kMiB);
-}
-
-TEST(Extract, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
-{
-    // portability.hpp: a virtio device of id 0x0005 (the balloon) whose features (one '0' or '1'
-    // per bit) have bit 5 (free page reporting) set; in a fake sysfs tree
-    namespace fs = std::filesystem;
-    using cmc33::detail::balloon_reports_free_memory_in;
-    const fs::path root = cmc33::test::temp_dir() / "devices";
-    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/")); // no such directory
-    const auto device = [&](const char* name, const char* id, const char* features) {
-        fs::create_directories(root / name);
-        std::ofstream(root / name / "device") << id << "\n";
-        std::ofstream(root / name / "features") << features << "\n";
-    };
-    device("virtio0", "0x0002", "0110010100000000000000000000000010000000"); // a block device
-    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
-    device("virtio1", "0x0005", "0110000100000000000000000000000010000000"); // a balloon, no reporting
-    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
-    device("virtio1", "0x0005", "01100");
-    EXPECT_FALSE(balloon_reports_free_memory_in(root.string() + "/"));
-    device("virtio1", "0x0005", "0110010100000000000000000000000010000000"); // reporting
-    EXPECT_TRUE(balloon_reports_free_memory_in(root.string() + "/"));
-}
-
-TEST(Extract, BlocksTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
-{
-    // src/base/buffer.cpp: blocks of 1 MiB and more are advised for huge pages, except where the
-    // balloon hands free memory back to the host. Seen in /proc/self/smaps (THPeligible) when the
-    // kernel's THP mode is "madvise", where the advice decides.
-    std::string mode;
-    std::getline(std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"), mode);
-    if (mode.find("[madvise]") == std::string::npos) GTEST_SKIP() << "THP mode is not madvise: " << mode;
-    const auto eligible = [](const void* p) {
-        std::ifstream smaps("/proc/self/smaps");
-        const auto at = reinterpret_cast<std::uintptr_t>(p);
-        bool inside = false;
-        for (std::string line; std::getline(smaps, line);) {
-            unsigned long lo = 0, hi = 0;
-            if (std::sscanf(line.c_str(), "%lx-%lx ", &lo, &hi) == 2) { // a mapping's header line
-                inside = lo <= at && at < hi;
-            } else if (inside && line.rfind("THPeligible:", 0) == 0) {
-                return line.find('1') != std::string::npos;
-            }
-        }
-        ADD_FAILURE() << "no THPeligible line for " << p;
-        return false;
-    };
-    constexpr std::size_t kMiB = std::size_t{1} << 20;
-    const bool advised = !cmc33::detail::balloon_reports_free_memory();
-    for (const std::size_t bytes : {3 * kMiB, 28 * kMiB, 36 * kMiB}) { // up to 16 MiB, past it, past 32 MiB
-        void* block = cmc33::detail::allocate_buffer(bytes);
-        EXPECT_EQ(eligible(block), advised) << bytes << " bytes";
-        cmc33::detail::deallocate_buffer(block, bytes);
-    }
 }
 
 TEST(Extract, IntegerTiesHaveNoHolesAndNoNonManifoldEdges)
