@@ -4,7 +4,6 @@
 
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -83,10 +82,7 @@ TEST(VolumeShared, EveryVolumeReadsAsTheReadmeSays)
         if (!path) continue;
         ++found;
         SCOPED_TRACE(expected.file);
-        const auto start = std::chrono::steady_clock::now();
         const Volume v = read_volume(*path);
-        const double seconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         EXPECT_EQ(v.dims(), expected.dims);
         EXPECT_EQ(v.type(), expected.type) << type_name(v.type());
         for (std::size_t axis = 0; axis < 3; ++axis) {
@@ -100,7 +96,6 @@ TEST(VolumeShared, EveryVolumeReadsAsTheReadmeSays)
         } else {
             EXPECT_LT(lo, hi); // not a constant (e.g. all-zero) volume
         }
-        RecordProperty(expected.file + "_seconds", std::to_string(seconds));
     }
     if (found == 0) GTEST_SKIP() << "shared/data/volumes is not beside the repository";
 }
