@@ -436,6 +436,32 @@ void weld(std::vector<Part>& parts, std::size_t plane, LabelSurfaces& out)
     }
 }
 
+// Counts, offsets, fill: the triangles of each selected label in ascending order.
+void index_by_label(LabelSurfaces& s)
+{
+    const std::size_t n = s.selected.size(), none = n;
+    const auto slot = [&](std::int64_t label) {
+        const auto it = std::lower_bound(s.selected.begin(), s.selected.end(), label);
+        return it != s.selected.end() && *it == label ? static_cast<std::size_t>(it - s.selected.begin()) : none;
+    };
+    s.by_label_start.assign(n + 1, 0);
+    for (std::size_t t = 0; t < s.front.size(); ++t) {
+        for (const std::int64_t label : {s.front[t], s.behind[t]}) {
+            const std::size_t i = slot(label);
+            if (i != none) ++s.by_label_start[i + 1];
+        }
+    }
+    for (std::size_t i = 0; i < n; ++i) s.by_label_start[i + 1] += s.by_label_start[i];
+    s.by_label.resize(s.by_label_start[n]);
+    std::vector<std::size_t> next(s.by_label_start.begin(), s.by_label_start.end() - 1);
+    for (std::size_t t = 0; t < s.front.size(); ++t) {
+        for (const std::int64_t label : {s.front[t], s.behind[t]}) {
+            const std::size_t i = slot(label);
+            if (i != none) s.by_label[next[i]++] = static_cast<std::uint32_t>(t);
+        }
+    }
+}
+
 template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
 {
     LabelSurfaces out;
@@ -469,6 +495,8 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
         // nothing selected: no cell was triangulated, none counted
         out.cells_two_labels = out.cells_many_labels = 0;
     }
+    // with many labels, finding each one's triangles by a scan of all would cost labels x triangles
+    if (out.selected.size() > 8 && out.front.size() < kNone) index_by_label(out);
     return out;
 }
 
@@ -543,8 +571,15 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
     // an unselected label's interfaces with other unselected labels were not made
     if (!std::binary_search(surfaces.selected.begin(), surfaces.selected.end(), label)) return out;
     std::vector<std::size_t> mine;
-    for (std::size_t t = 0; t < all.triangle_count(); ++t) {
-        if (surfaces.front[t] == label || surfaces.behind[t] == label) mine.push_back(t);
+    if (!surfaces.by_label_start.empty()) {
+        const auto i = static_cast<std::size_t>(
+            std::lower_bound(surfaces.selected.begin(), surfaces.selected.end(), label) - surfaces.selected.begin());
+        mine.assign(surfaces.by_label.begin() + static_cast<std::ptrdiff_t>(surfaces.by_label_start[i]),
+                    surfaces.by_label.begin() + static_cast<std::ptrdiff_t>(surfaces.by_label_start[i + 1]));
+    } else {
+        for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+            if (surfaces.front[t] == label || surfaces.behind[t] == label) mine.push_back(t);
+        }
     }
     out.triangles.reserve(3 * mine.size());
     const std::size_t most = std::min(all.vertex_count(), 3 * mine.size());

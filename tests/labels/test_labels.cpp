@@ -122,6 +122,25 @@ TEST(Labels, SameOutputForEveryThreadCount)
             }
 }
 
+// More than 8 labels selected: label_surface() reads the index by label, which gives the meshes a
+// scan of every triangle gives.
+TEST(Labels, IndexByLabelGivesTheScansSurfaces)
+{
+    const Volume v = label_checks::random_labels(9, 12, 5, true);
+    const LabelSurfaces indexed = label_surfaces(v);
+    ASSERT_GT(indexed.selected.size(), 8U);
+    ASSERT_EQ(indexed.by_label_start.size(), indexed.selected.size() + 1);
+    LabelSurfaces scanned = indexed;
+    scanned.by_label.clear();
+    scanned.by_label_start.clear();
+    for (const std::int64_t l : indexed.selected) {
+        const Mesh a = label_surface(indexed, l), b = label_surface(scanned, l);
+        EXPECT_GT(a.triangle_count(), 0U) << l;
+        EXPECT_TRUE(a.triangles == b.triangles) << l;
+        EXPECT_TRUE(a.positions == b.positions) << l;
+    }
+}
+
 TEST(Labels, SelectionAndBackground)
 {
     Volume v = label_checks::random_labels(7, 4, 3, true);

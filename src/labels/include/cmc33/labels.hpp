@@ -49,6 +49,10 @@ struct LabelSurfaces {
     std::vector<std::int64_t> selected;      ///< the labels that get surfaces, ascending
     std::int64_t cells_two_labels = 0;       ///< cells with exactly two labels (cmc33's triangulation)
     std::int64_t cells_many_labels = 0;      ///< cells with three or more (the centre construction)
+    /// label_surface()'s index when many labels are selected (empty otherwise): the triangles with
+    /// selected[i] on a side are by_label[by_label_start[i] .. by_label_start[i + 1]), ascending.
+    std::vector<std::uint32_t> by_label;
+    std::vector<std::size_t> by_label_start;
 };
 
 /// One pass over `labels` (an integer sample type).
