@@ -42,7 +42,15 @@ void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, cons
     if ((c.vertices_ > 0 && out.positions == nullptr) || (c.triangles_ > 0 && out.triangles == nullptr)) {
         throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
     }
-    const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
+    const bool block = out.whole_dims != Index3{0, 0, 0};
+    const Emit e{c,
+                 off,
+                 out,
+                 gradient_scale(c.largest_sample_),
+                 block ? min_crossing(out.whole_dims, g_.origin, m_) : delta_,
+                 {out.index_offset[0], out.index_offset[1], out.index_offset[2]},
+                 block ? out.whole_dims[0] : nx_,
+                 block ? out.whole_dims[1] : ny_};
     Scratch s(nx_, ny_);
     if (out.vertex_cell_ranges) s.ranges.emplace(nx_, ny_);
     std::size_t decision = 0; // the next of count's decisions
@@ -373,8 +381,10 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std
     const MeshSpans& out = e.out;
     const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
     const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
-    const double t = crossing(a, b);
-    const double p[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+    const double t = crossing(a, b, e.delta);
+    // the larger grid's index (MeshSpans::index_offset): p + t sums as its extract() does
+    const double p[3] = {static_cast<double>(i + e.offset[0]), static_cast<double>(j + e.offset[1]),
+                         static_cast<double>(k + e.offset[2])};
     double x[3];
     for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
     const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
@@ -393,7 +403,7 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std
         }
     }
     if constexpr (kOut == Outputs::all) {
-        if (out.vertex_edges) out.vertex_edges[v] = 3 * (i + nx_ * (j + ny_ * k)) + axis;
+        if (out.vertex_edges) out.vertex_edges[v] = 3 * e.whole_cell(i, j, k) + axis;
         if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
         if (out.vertex_values) {
             const double va = static_cast<double>(a), vb = static_cast<double>(b);
@@ -457,7 +467,7 @@ void RangeExtractor<T>::emit_row_cells(std::int64_t j, std::int64_t k, const Row
         }
         if constexpr (kOut == Outputs::all) {
             if (out.triangle_cells) {
-                const std::int64_t cell = i + nx_ * (j + ny_ * k);
+                const std::int64_t cell = e.whole_cell(i, j, k);
                 for (int q = 0; q < count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
         }
@@ -506,7 +516,7 @@ int RangeExtractor<T>::emit_cell(std::int64_t i, std::int64_t j, std::int64_t k,
 #define CMC33_INSTANTIATE(T) \
     template void RangeExtractor<T>::emit(const RangeCounts&, const RangeOffsets&, const MeshSpans&, Ticker*) const; \
     template void RangeExtractor<T>::build_short_tilings(); \
-    template double RangeExtractor<T>::min_crossing(const GridView<T>&, const Mat3&);
+    template double RangeExtractor<T>::min_crossing(const Index3&, const Vec3&, const Mat3&);
 CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 

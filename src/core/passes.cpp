@@ -32,6 +32,27 @@ void check_passes_method(const ExtractOptions& options, const char* pass)
     }
 }
 
+std::string index_text(const Index3& v)
+{
+    return "(" + std::to_string(v[0]) + ", " + std::to_string(v[1]) + ", " + std::to_string(v[2]) + ")";
+}
+
+/// MeshSpans' place of the grid in a larger one: none (both zero), or inside it.
+void check_block(const Index3& dims, const MeshSpans& out)
+{
+    const bool whole = out.whole_dims == Index3{0, 0, 0};
+    bool inside = true;
+    for (std::size_t a = 0; a < 3; ++a) {
+        inside &= whole ? out.index_offset[a] == 0
+                        : out.index_offset[a] >= 0 && out.index_offset[a] <= out.whole_dims[a] - dims[a];
+    }
+    if (!inside) {
+        throw Error(Status::invalid_argument, "emit: MeshSpans places the grid of " + index_text(dims) + " samples at index_offset " +
+                                                  index_text(out.index_offset) + " in whole_dims " + index_text(out.whole_dims) +
+                                                  "; expected 0 <= index_offset <= whole_dims - dims, or both zero");
+    }
+}
+
 } // namespace
 
 template <class T>
@@ -92,6 +113,7 @@ void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, co
                                                   std::to_string(grid.ny()) + "x" + std::to_string(grid.nz()) +
                                                   "); expected counts from count() on the same grid");
     }
+    check_block(grid.dims, out);
     detail::RangeExtractor<T>(grid, iso, options).emit(counts, offsets, out, nullptr);
 }
 

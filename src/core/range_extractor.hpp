@@ -44,7 +44,7 @@ public:
         : g_(g), iso_(iso), threshold_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
           words_((nx_ + 63) / 64), x_valid_(valid_words(words_, nx_ - 1)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
-          delta_(min_crossing(g, m_)), variants_(detail::tables_of(opt.method))
+          delta_(min_crossing(g.dims, g.origin, m_)), variants_(detail::tables_of(opt.method))
     {
         for (std::size_t a = 0; a < 3; ++a) {
             step_[a] = diagonal_ ? m_[a][a] : 1.0;
@@ -156,6 +156,17 @@ private:
         const RangeOffsets& off;
         const MeshSpans& out;
         double gradient_scale;
+        /// Crossings lie in [delta, 1 - delta]: delta_, or the larger grid's (MeshSpans::whole_dims)
+        double delta;
+        /// MeshSpans::index_offset, and the larger grid's nx and ny (the grid's own without one):
+        /// positions and the numbers of edges and cells are those of the larger grid's index
+        std::int64_t offset[3];
+        std::int64_t whole_nx, whole_ny;
+        /// The larger grid's number of cell (i, j, k) of this grid (vertex_edges, triangle_cells)
+        std::int64_t whole_cell(std::int64_t i, std::int64_t j, std::int64_t k) const
+        {
+            return (i + offset[0]) + whole_nx * ((j + offset[1]) + whole_ny * (k + offset[2]));
+        }
         /// One past the range's last triangle id: a short tiling's fixed-size copy may write past
         /// its row's triangles into those of the range's next rows, which this thread writes
         /// later, but not past the range's (another thread's, or the end of the caller's output).
@@ -274,12 +285,13 @@ private:
 
     /// The crossing parameter of the edge from sample value a to b, in [delta, 1 - delta]
     /// (src/core/placement.hpp: never on a sample, so ties do not collapse triangles).
-    double crossing(T a, T b) const;
+    double crossing(T a, T b, double delta) const;
 
-    /// delta of placement.hpp for this grid: 2^-10 of an edge, or more where the output floats
-    /// cannot tell a point delta along an edge from the sample (16 units in the last place of the
-    /// largest coordinate, at most 1/8 of an edge).
-    static double min_crossing(const GridView<T>& g, const Mat3& m);
+    /// delta of placement.hpp for a grid of `dims` samples at `origin` with index-to-world map m:
+    /// 2^-10 of an edge, or more where the output floats cannot tell a point delta along an edge
+    /// from the sample (16 units in the last place of the largest coordinate, at most 1/8 of an
+    /// edge).
+    static double min_crossing(const Index3& dims, const Vec3& origin, const Mat3& m);
 
     /// The world position of index-space point x (the frame of volume.hpp), rounded to float, as
     /// (x, y, z) or with `zyx` (MeshSpans) as (z, y, x).
@@ -382,7 +394,8 @@ private:
     /// critical point), the surface still has a side. Triangles wind with their normals toward the
     /// below side (mc33_tables.hpp), in index space; M^-T takes them to world space as it does
     /// gradients.
-    std::array<double, 3> fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3]) const;
+    std::array<double, 3> fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3],
+                                       double delta) const;
 
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
     /// placement.hpp from the cell's crossings; normals interpolate the corners' gradients.
@@ -401,7 +414,7 @@ private:
     double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
     double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
-    double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge
+    double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge (the grid's own box)
     /// The method's table set (detail::tables_of): chosen once here, so the passes' loops read one
     /// pointer and nothing in them depends on the method
     const detail::Variant* variants_;

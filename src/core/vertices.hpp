@@ -22,22 +22,22 @@
 namespace cmc33::detail {
 
 template <class T>
-double RangeExtractor<T>::crossing(T a, T b) const
+double RangeExtractor<T>::crossing(T a, T b, double delta) const
 {
     const double va = static_cast<double>(a), vb = static_cast<double>(b);
     const double d = vb - va; // ends differ in sign: vb != va
     if (std::isinf(d)) {
         // |vb - va| passes DBL_MAX (samples near +-1e308): the same ratio on halved values,
         // which cannot overflow; iso lies between va and vb, so |iso - va| <= |vb - va|
-        return detail::clamp_crossing((0.5 * iso_ - 0.5 * va) / (0.5 * vb - 0.5 * va), delta_);
+        return detail::clamp_crossing((0.5 * iso_ - 0.5 * va) / (0.5 * vb - 0.5 * va), delta);
     }
-    return detail::clamp_crossing((iso_ - va) / d, delta_);
+    return detail::clamp_crossing((iso_ - va) / d, delta);
 }
 
 template <class T>
-double RangeExtractor<T>::min_crossing(const GridView<T>& g, const Mat3& m)
+double RangeExtractor<T>::min_crossing(const Index3& dims, const Vec3& origin, const Mat3& m)
 {
-    const double largest = largest_coordinate(g);
+    const double largest = largest_coordinate(dims, origin, m);
     const double shortest = shortest_edge(m);
     if (!(largest > 0) || !(shortest > 0) || !std::isfinite(largest)) return detail::kMinCrossing;
     const double ulp = std::ldexp(1.0, std::ilogb(largest) - 23);
@@ -198,13 +198,14 @@ std::array<double, 3> RangeExtractor<T>::cell_gradient(const T (&value)[8], cons
 }
 
 template <class T>
-std::array<double, 3> RangeExtractor<T>::fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3]) const
+std::array<double, 3> RangeExtractor<T>::fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3],
+                                                      double delta) const
 {
     double crossings[12][3]; // the crossed edges' points (interior_position reads only those)
     for (int edge = 0; edge < 12; ++edge) {
         const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
         const bool crossed = (static_cast<double>(value[a]) >= iso_) != (static_cast<double>(value[b]) >= iso_);
-        const double t = crossed ? crossing(value[a], value[b]) : 0.5;
+        const double t = crossed ? crossing(value[a], value[b], delta) : 0.5;
         for (int c = 0; c < 3; ++c) crossings[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
     }
     const auto point = [&](int code, double (&x)[3]) {
@@ -254,7 +255,7 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
     for (unsigned left = needed; left != 0; left &= left - 1) { // set bits: no branch per edge
         const int edge = std::countr_zero(left);
         const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
-        const double t = crossing(value[a], value[b]);
+        const double t = crossing(value[a], value[b], e.delta);
         for (int c = 0; c < 3; ++c)
             crossing_at[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
     }
@@ -275,7 +276,9 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
             }
         }
     }
-    const double base[3] = {static_cast<double>(i), static_cast<double>(j), static_cast<double>(k)};
+    // the larger grid's index (MeshSpans::index_offset): base + p sums as its extract() does
+    const double base[3] = {static_cast<double>(i + e.offset[0]), static_cast<double>(j + e.offset[1]),
+                            static_cast<double>(k + e.offset[2])};
     for (int q = 0; q < tl.interior_count; ++q) {
         double p[3];
         detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
@@ -290,10 +293,10 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
                 for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
             if (!write_normal(&out.normals[v * 3], n, out.zyx) &&
                 !write_normal(&out.normals[v * 3], cell_gradient(value, p, e.gradient_scale), out.zyx)) {
-                write_normal(&out.normals[v * 3], fan_gradient(value, tl, q, p), out.zyx);
+                write_normal(&out.normals[v * 3], fan_gradient(value, tl, q, p, e.delta), out.zyx);
             }
         }
-        if (out.vertex_edges) out.vertex_edges[v] = -1 - (i + nx_ * (j + ny_ * k));
+        if (out.vertex_edges) out.vertex_edges[v] = -1 - e.whole_cell(i, j, k);
         if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
         if (out.vertex_cell_ranges) out.vertex_cell_ranges[v] = static_cast<float>(cell_range(i, j, k));
         if (out.vertex_values) {

@@ -8,11 +8,13 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <random>
@@ -578,6 +580,95 @@ TEST(Passes, WindowsHoldTheSamplesOfEveryTypeAndLayout)
 }
 
 /// The status f() throws, or nullopt when it returns.
+/// count and emit over the whole of `g` with the extras, placed at `offset` in a grid of `whole`
+/// samples (MeshSpans::index_offset, whole_dims; zero: g itself).
+Output run_placed(const GridView<double>& g, double iso, cmc33::Index3 offset, cmc33::Index3 whole)
+{
+    const ExtractOptions opt;
+    const RangeCounts c = cmc33::count(g, iso, opt, 0, g.nz());
+    Output o;
+    const auto nv = static_cast<std::size_t>(c.vertex_count()), nt = static_cast<std::size_t>(c.triangle_count());
+    o.positions = std::vector<float>(3 * nv), o.normals = std::vector<float>(3 * nv);
+    o.edges = std::vector<std::int64_t>(nv), o.cells = std::vector<std::int64_t>(nt);
+    o.triangles = std::vector<std::uint32_t>(3 * nt);
+    MeshSpans out;
+    out.positions = o.positions.data(), out.normals = o.normals.data(), out.triangles = o.triangles.data();
+    out.vertex_edges = o.edges.data(), out.triangle_cells = o.cells.data();
+    out.index_offset = offset, out.whole_dims = whole;
+    cmc33::emit(g, iso, opt, c, {}, out);
+    return o;
+}
+
+/// Per vertex a key in the whole grid: its edge, or for an interior vertex -1 - (32 cell + rank).
+std::vector<std::int64_t> vertex_keys(const Output& o)
+{
+    std::vector<std::int64_t> keys(o.edges.size());
+    std::int64_t previous = 0, rank = 0;
+    for (std::size_t v = 0; v < keys.size(); ++v) {
+        const std::int64_t e = o.edges[v];
+        rank = e < 0 && v > 0 && e == previous ? rank + 1 : 0;
+        previous = e;
+        keys[v] = e >= 0 ? e : -1 - (32 * (-1 - e) + rank);
+    }
+    return keys;
+}
+
+TEST(Passes, ABlockPlacedInTheWholeGridWritesTheWholesVerticesBitForBit)
+{
+    // far from the origin, where crossings keep 2^-8 / 0.75 of an edge from the samples in the
+    // whole grid's box (z to 2055) and half that in the block's own (z to 2045): the whole's
+    // margin must be taken; an anisotropic spacing, and a frame that is not diagonal
+    const Volume n = noise({23, 19, 21}, 5);
+    const cmc33::Mat3 rotated{{{0.6, -0.8, 0}, {0.8, 0.6, 0}, {0, 0, 1}}};
+    for (const cmc33::Mat3& direction : {cmc33::kIdentity3, rotated}) {
+        GridView<double> whole = n.view<double>();
+        whole.spacing = {0.75, 1.25, 2.0}, whole.origin = {1500.0, -900.25, 2015.0}, whole.direction = direction;
+        const Output w = run_placed(whole, 0.0, {0, 0, 0}, {0, 0, 0});
+        const std::vector<std::int64_t> wkeys = vertex_keys(w);
+        std::map<std::int64_t, std::size_t> at;
+        for (std::size_t v = 0; v < wkeys.size(); ++v) at[wkeys[v]] = v;
+        std::map<std::int64_t, std::vector<std::int64_t>> tiles; // cell -> its triangles' keys
+        for (std::size_t t = 0; t < w.cells.size(); ++t)
+            for (std::size_t q = 0; q < 3; ++q) tiles[w.cells[t]].push_back(wkeys[w.triangles[3 * t + q]]);
+
+        const cmc33::Index3 offset{5, 4, 6}, dims{9, 8, 10};
+        GridView<double> block = whole;
+        block.data = whole.data + whole.offset(offset[0], offset[1], offset[2]);
+        block.dims = dims;
+        const Output b = run_placed(block, 0.0, offset, whole.dims);
+        const std::vector<std::int64_t> bkeys = vertex_keys(b);
+        EXPECT_TRUE(std::any_of(b.edges.begin(), b.edges.end(), [](std::int64_t e) { return e < 0; })) << "no interior vertex";
+        std::size_t inner = 0;
+        for (std::size_t v = 0; v < bkeys.size(); ++v) {
+            const auto found = at.find(bkeys[v]);
+            ASSERT_NE(found, at.end()) << "block vertex " << v << " key " << bkeys[v];
+            for (std::size_t c = 0; c < 3; ++c) {
+                EXPECT_EQ(std::bit_cast<std::uint32_t>(b.positions[3 * v + c]),
+                          std::bit_cast<std::uint32_t>(w.positions[3 * found->second + c]))
+                    << "vertex " << v << " coordinate " << c;
+            }
+            // normals: equal where the edge's ends have their neighbours inside the block
+            const std::int64_t e = b.edges[v] >= 0 ? b.edges[v] / 3 : -1 - b.edges[v];
+            const std::int64_t g[3] = {e % whole.nx(), e / whole.nx() % whole.ny(), e / (whole.nx() * whole.ny())};
+            bool inside = true;
+            for (std::size_t c = 0; c < 3; ++c) inside &= g[c] - offset[c] >= 1 && g[c] - offset[c] + 2 < dims[c];
+            if (!inside) continue;
+            ++inner;
+            for (std::size_t c = 0; c < 3; ++c) {
+                EXPECT_EQ(std::bit_cast<std::uint32_t>(b.normals[3 * v + c]),
+                          std::bit_cast<std::uint32_t>(w.normals[3 * found->second + c]))
+                    << "normal of vertex " << v;
+            }
+        }
+        EXPECT_GT(inner, 50u);
+        std::map<std::int64_t, std::vector<std::int64_t>> block_tiles;
+        for (std::size_t t = 0; t < b.cells.size(); ++t)
+            for (std::size_t q = 0; q < 3; ++q) block_tiles[b.cells[t]].push_back(bkeys[b.triangles[3 * t + q]]);
+        ASSERT_FALSE(block_tiles.empty());
+        for (const auto& [cell, keys] : block_tiles) EXPECT_EQ(keys, tiles[cell]) << "cell " << cell;
+    }
+}
+
 template <class F> std::optional<cmc33::Status> status_of(F&& f)
 {
     try {
@@ -636,6 +727,19 @@ TEST(Passes, MisuseIsRefusedBeforeAnyWrite)
     RangeOffsets huge;
     huge.first_vertex = 4294967000;
     EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, opt, a, huge, out); }), Status::too_large);
+    // a block's place in a larger grid: inside it, and an offset only with the larger grid's dims
+    for (const auto& [offset, whole] : {std::pair<cmc33::Index3, cmc33::Index3>{{1, 0, 0}, {0, 0, 0}},
+                                        {{1, 0, 0}, {32, 32, 32}},
+                                        {{-1, 0, 0}, {40, 40, 40}},
+                                        {{0, 0, 9}, {40, 40, 40}}}) {
+        MeshSpans placed = out;
+        placed.index_offset = offset, placed.whole_dims = whole;
+        EXPECT_EQ(status_of([&] { cmc33::emit(g, 100.5, opt, a, {}, placed); }), Status::invalid_argument)
+            << offset[0] << " " << offset[2] << " " << whole[0];
+    }
+    MeshSpans placed = out;
+    placed.index_offset = {8, 0, 8}, placed.whole_dims = {40, 32, 40};
+    cmc33::emit(g, 100.5, opt, a, {}, placed); // inside: fine
 }
 
 } // namespace

@@ -112,7 +112,8 @@ struct MeshSpans {
     float* normals = nullptr;            ///< 3 per vertex, unit; computed only when not null
     /// Per vertex, for interpolating other point data (a VTK filter's needs): the grid edge of an
     /// edge vertex, 3 * (i + nx * (j + ny * k)) + axis for the edge from sample (i, j, k) along axis;
-    /// for an interior vertex -1 - c, c = i + nx * (j + ny * k) the lowest corner of its cell.
+    /// for an interior vertex -1 - c, c = i + nx * (j + ny * k) the lowest corner of its cell
+    /// (indices and nx, ny of the larger grid with whole_dims).
     std::int64_t* vertex_edges = nullptr;
     /// Per vertex: an edge vertex's parameter t in (0, 1) along its edge, from the edge's lower
     /// sample (value a) to its upper one (b); -1 for an interior vertex.
@@ -120,7 +121,8 @@ struct MeshSpans {
     /// Per vertex: the trilinear interpolant of the samples at the vertex (close to iso: crossings
     /// are kept delta away from samples, docs/conventions.md "Geometry").
     float* vertex_values = nullptr;
-    /// Per triangle: the cell it lies in, i + nx * (j + ny * k) of the cell's lowest corner.
+    /// Per triangle: the cell it lies in, i + nx * (j + ny * k) of the cell's lowest corner (the
+    /// larger grid's with whole_dims).
     std::int64_t* triangle_cells = nullptr;
     /// Per vertex: the largest range of samples (largest minus smallest of a cell's 8) among the
     /// cells whose triangles use the vertex: for an edge vertex every cell of the grid around its
@@ -135,6 +137,19 @@ struct MeshSpans {
     bool reverse_winding = false;
     std::int64_t first_vertex = 0;   ///< global id of element 0 of the vertex arrays
     std::int64_t first_triangle = 0; ///< global id of element 0 of the triangle arrays
+    /// For a grid that is a block of a larger one (a chunk of a Dask array, cmc33.dask): the
+    /// larger grid's index of this grid's sample (0, 0, 0). The grid's origin, spacing and
+    /// direction are then the larger grid's; positions are written at the larger grid's index
+    /// (origin + M * (index_offset + (i, j, k) + u), the sum in double as extract() of the larger
+    /// grid sums it) and vertex_edges and triangle_cells number the larger grid's edges and cells,
+    /// so that a block writes its vertices' bytes as extract() of the whole writes them. Normals
+    /// read this grid's samples: equal to the whole's where each vertex's edge ends have their
+    /// neighbours in the block. Zero (with whole_dims zero): the grid is the whole.
+    Index3 index_offset{0, 0, 0};
+    /// The larger grid's samples, with index_offset: its box (origin and M) sets how far crossings
+    /// stay from the samples (docs/conventions.md, "Geometry"), as it does for extract() of it.
+    /// Zero: the grid's own dims (index_offset must then be zero).
+    Index3 whole_dims{0, 0, 0};
 };
 
 /// Pass 1 on sample planes [k0, k1): classifies and decides every cell the range owns and counts
