@@ -1,0 +1,23 @@
+# cmake -DSOURCE_DIR=<repository> -P umbrella.cmake: fails naming every public header
+# (src/<part>/include/cmc33/*.hpp, and the generated version.hpp) that the umbrella header
+# include/cmc33/cmc33.hpp does not include.
+file(READ "${SOURCE_DIR}/include/cmc33/cmc33.hpp" umbrella)
+file(GLOB headers "${SOURCE_DIR}/src/*/include/cmc33/*.hpp" "${SOURCE_DIR}/src/*/include/cmc33/*.hpp.in")
+set(missing "")
+foreach(header IN LISTS headers)
+    get_filename_component(name "${header}" NAME)
+    string(REGEX REPLACE "\\.in$" "" name "${name}")
+    string(FIND "${umbrella}" "#include \"cmc33/${name}\"" at)
+    if(at EQUAL -1)
+        list(APPEND missing "cmc33/${name}")
+    endif()
+endforeach()
+list(LENGTH headers count)
+if(count EQUAL 0)
+    message(FATAL_ERROR "umbrella.cmake: no public header found under ${SOURCE_DIR}/src/*/include/cmc33")
+endif()
+if(missing)
+    string(REPLACE ";" ", " missing "${missing}")
+    message(FATAL_ERROR "include/cmc33/cmc33.hpp does not include ${missing}; the umbrella header must include every public header")
+endif()
+message(STATUS "the umbrella header includes all ${count} public headers")
