@@ -87,9 +87,8 @@ constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 class Placer {
 public:
     Placer(const Vec3& spacing, const Vec3& origin, const Mat3& direction)
-        : m_(frame_matrix(spacing, direction)), origin_(origin)
+        : m_(frame_matrix(spacing, direction)), origin_(origin), diagonal_(is_diagonal(m_))
     {
-        diagonal_ = m_[0][1] == 0 && m_[0][2] == 0 && m_[1][0] == 0 && m_[1][2] == 0 && m_[2][0] == 0 && m_[2][1] == 0;
     }
     void put(Buffer<float>& out, double x, double y, double z) const
     {
