@@ -7,9 +7,11 @@
 #include <algorithm>
 #include <array>
 #include <charconv>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "cmc33/cell.hpp"
@@ -355,8 +357,14 @@ private:
         return static_cast<std::uint32_t>(n);
     }
 
-    void add(const std::array<std::uint32_t, 3>& v, std::int64_t front, std::int64_t behind)
+    void add(std::array<std::uint32_t, 3> v, std::int64_t front, std::int64_t behind)
     {
+        // every triangle faces its higher label: the interface of two labels is one sheet wound
+        // one way, so that its vertex normals can point to every triangle's front
+        if (front < behind) {
+            std::swap(v[1], v[2]);
+            std::swap(front, behind);
+        }
         // a mirroring frame reverses every winding
         out_.triangles.push_back(v[0]);
         out_.triangles.push_back(flip_ ? v[2] : v[1]);
@@ -435,6 +443,84 @@ void weld(std::vector<Part>& parts, std::size_t plane, LabelSurfaces& out)
     }
 }
 
+using Normal = std::array<double, 3>;
+
+// The normal of interface triangle t as wound, twice its area long, from the float positions.
+Normal face_normal(const Mesh& m, std::size_t t)
+{
+    const float* p = m.positions.data();
+    const std::uint32_t* v = &m.triangles[3 * t];
+    Normal a{}, b{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        a[k] = static_cast<double>(p[3 * v[1] + k]) - static_cast<double>(p[3 * v[0] + k]);
+        b[k] = static_cast<double>(p[3 * v[2] + k]) - static_cast<double>(p[3 * v[0] + k]);
+    }
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double length(const Normal& n) { return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); }
+
+// Unit normals of `vertices` vertices: the sum of the normals `face(i)` (twice the area long) of
+// the triangles `corners(i)`, i < `triangles`, at each vertex, summed in triangle order so that the
+// bytes depend on nothing else. Where the sum vanishes against the areas (triangles that cancel)
+// the vertex takes its largest triangle's normal (the first of equals), and where it has only
+// zero-area triangles (0, 0, up(v)): finite and unit everywhere. A surface whose faces are another's
+// negated, in the same order, gets exactly the negated normals.
+template <class Corners, class Face, class Up>
+Buffer<float> vertex_normals(std::size_t vertices, std::size_t triangles, Corners&& corners, Face&& face, Up&& up)
+{
+    std::vector<std::array<double, 4>> sum(vertices, {0, 0, 0, 0}); // the normals' sum, their lengths' sum
+    for (std::size_t i = 0; i < triangles; ++i) {
+        const Normal n = face(i);
+        const double l = length(n);
+        for (const std::uint32_t v : corners(i)) {
+            auto& s = sum[v];
+            s[0] += n[0];
+            s[1] += n[1];
+            s[2] += n[2];
+            s[3] += l;
+        }
+    }
+    Buffer<float> out(3 * vertices);
+    std::vector<std::uint32_t> degenerate;
+    for (std::size_t v = 0; v < vertices; ++v) {
+        const auto& s = sum[v];
+        const double l = length({s[0], s[1], s[2]});
+        // relative to the areas, so that rounding left by cancelling triangles is no direction
+        if (!(l > 1e-9 * s[3]) || !(l > 0) || !std::isfinite(l)) {
+            degenerate.push_back(static_cast<std::uint32_t>(v));
+            continue;
+        }
+        for (std::size_t k = 0; k < 3; ++k) out[3 * v + k] = static_cast<float>(s[k] / l);
+    }
+    if (degenerate.empty()) return out;
+    std::vector<std::uint32_t> slot(vertices, kNone);
+    for (std::size_t d = 0; d < degenerate.size(); ++d) slot[degenerate[d]] = static_cast<std::uint32_t>(d);
+    std::vector<Normal> best(degenerate.size(), Normal{0, 0, 0});
+    std::vector<double> best_length(degenerate.size(), 0);
+    for (std::size_t i = 0; i < triangles; ++i) {
+        bool any = false;
+        for (const std::uint32_t v : corners(i)) any = any || slot[v] != kNone;
+        if (!any) continue;
+        const Normal n = face(i);
+        const double l = length(n);
+        if (!std::isfinite(l)) continue;
+        for (const std::uint32_t v : corners(i)) {
+            if (slot[v] == kNone || !(l > best_length[slot[v]])) continue;
+            best[slot[v]] = n;
+            best_length[slot[v]] = l;
+        }
+    }
+    for (std::size_t d = 0; d < degenerate.size(); ++d) {
+        const std::size_t v = degenerate[d];
+        const double l = best_length[d];
+        for (std::size_t k = 0; k < 3; ++k) {
+            out[3 * v + k] = l > 0 ? static_cast<float>(best[d][k] / l) : (k == 2 ? static_cast<float>(up(v)) : 0.0F);
+        }
+    }
+    return out;
+}
+
 // Counts, offsets, fill: the triangles of each selected label in ascending order.
 void index_by_label(LabelSurfaces& s)
 {
@@ -496,6 +582,15 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
     }
     // with many labels, finding each one's triangles by a scan of all would cost labels x triangles
     if (out.selected.size() > 8 && out.front.size() < kNone) index_by_label(out);
+    if (options.normals) {
+        const Mesh& m = out.interfaces;
+        out.interfaces.normals = vertex_normals(
+            m.vertex_count(), m.triangle_count(),
+            [&](std::size_t t) {
+                return std::array<std::uint32_t, 3>{m.triangles[3 * t], m.triangles[3 * t + 1], m.triangles[3 * t + 2]};
+            },
+            [&](std::size_t t) { return face_normal(m, t); }, [](std::size_t) { return 1.0; });
+    }
     return out;
 }
 
@@ -606,12 +701,33 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
         }
         out.triangles.push_back(id);
     };
+    // for normals: the side of the first triangle at each vertex (the last resort's direction)
+    std::vector<signed char> first_side;
+    const bool normals = all.has_normals();
+    if (normals) first_side.reserve(most);
     for (const std::size_t t : mine) {
         // normals point into `front`; the label's surface points out of it
         const bool in_front = surfaces.front[t] == label;
         use(all.triangles[3 * t]);
         use(all.triangles[3 * t + (in_front ? 2 : 1)]);
         use(all.triangles[3 * t + (in_front ? 1 : 2)]);
+        if (normals && first_side.size() < out.vertex_count()) first_side.resize(out.vertex_count(), in_front ? -1 : 1);
+    }
+    if (normals) {
+        // the interface triangles' normals turned where the label is in front: exactly the negation
+        // of the other side's, whatever the arithmetic of a turned winding would round to
+        out.normals = vertex_normals(
+            out.vertex_count(), mine.size(),
+            [&](std::size_t i) {
+                return std::array<std::uint32_t, 3>{out.triangles[3 * i], out.triangles[3 * i + 1],
+                                                    out.triangles[3 * i + 2]};
+            },
+            [&](std::size_t i) {
+                Normal n = face_normal(all, mine[i]);
+                if (surfaces.front[mine[i]] == label) n = {-n[0], -n[1], -n[2]};
+                return n;
+            },
+            [&](std::size_t v) { return static_cast<double>(first_side[v]); });
     }
     return out;
 }

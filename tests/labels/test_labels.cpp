@@ -3,9 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 #include "cmc33/error.hpp"
 #include "cmc33/labels.hpp"
@@ -98,10 +102,19 @@ void expect_same(const LabelSurfaces& a, const LabelSurfaces& b, const std::stri
     EXPECT_EQ(a.selected, b.selected) << what;
     EXPECT_EQ(a.cells_two_labels, b.cells_two_labels) << what;
     EXPECT_EQ(a.cells_many_labels, b.cells_many_labels) << what;
+    ASSERT_EQ(a.interfaces.normals.size(), b.interfaces.normals.size()) << what;
+    EXPECT_EQ(std::memcmp(a.interfaces.normals.data(), b.interfaces.normals.data(), a.interfaces.normals.size() * 4), 0)
+        << what;
+    for (const std::int64_t l : a.selected) {
+        const Mesh ma = label_surface(a, l), mb = label_surface(b, l);
+        ASSERT_EQ(ma.normals.size(), mb.normals.size()) << what << ", label " << l;
+        EXPECT_EQ(std::memcmp(ma.normals.data(), mb.normals.data(), ma.normals.size() * 4), 0)
+            << what << ", label " << l;
+    }
 }
 
 // The cell pass runs on z-ranges welded afterwards: every thread count gives the same bytes,
-// including more threads than cell layers and a rotated frame.
+// including more threads than cell layers and a rotated frame, normals included.
 TEST(Labels, SameOutputForEveryThreadCount)
 {
     for (const int labels : {2, 4})
@@ -111,8 +124,10 @@ TEST(Labels, SameOutputForEveryThreadCount)
                 if (seed == 2) v.set_direction({{{0.6, 0.8, 0}, {-0.8, 0.6, 0}, {0, 0, 1}}});
                 LabelOptions o;
                 o.threads = 1;
+                o.normals = true;
                 const LabelSurfaces one = label_surfaces(v, o);
                 EXPECT_GT(one.interfaces.triangle_count(), 0U);
+                EXPECT_TRUE(one.interfaces.has_normals());
                 for (const int threads : {2, 3, 5, 8, 20}) {
                     o.threads = threads;
                     expect_same(one, label_surfaces(v, o),
@@ -201,6 +216,145 @@ TEST(Labels, WorldFrame)
     for (const std::int64_t l : world.selected) {
         EXPECT_TRUE(mesh_topology(label_surface(world, l)).oriented);
     }
+}
+
+using Vec = std::array<double, 3>;
+
+Vec face_normal(const Mesh& m, std::size_t t)
+{
+    Vec a{}, b{};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const auto at = [&](std::size_t c) { return static_cast<double>(m.positions[3 * m.triangles[3 * t + c] + k]); };
+        a[k] = at(1) - at(0);
+        b[k] = at(2) - at(0);
+    }
+    return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+
+double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+struct NormalCounts {
+    std::int64_t vertices = 0;   ///< label surfaces' vertices checked
+    std::int64_t faint = 0;      ///< where the faces' sum is under a tenth of their areas (pinches)
+    std::int64_t two_label = 0;  ///< label surfaces' vertices that only two labels share
+};
+
+// Every normal of `m` finite and unit, and on the side of the area-weighted sum of its faces'
+// normals (as the test computes it) wherever that sum is not vanishing against the areas.
+void expect_unit_and_with_the_faces(const Mesh& m, const std::string& what, NormalCounts& counts)
+{
+    ASSERT_EQ(m.normals.size(), m.positions.size()) << what;
+    std::vector<Vec> sum(m.vertex_count(), Vec{0, 0, 0});
+    std::vector<double> area(m.vertex_count(), 0);
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+        const Vec n = face_normal(m, t);
+        for (std::size_t c = 0; c < 3; ++c) {
+            const std::uint32_t v = m.triangles[3 * t + c];
+            for (std::size_t k = 0; k < 3; ++k) sum[v][k] += n[k];
+            area[v] += std::sqrt(dot(n, n));
+        }
+    }
+    for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+        const Vec n{static_cast<double>(m.normals[3 * v]), static_cast<double>(m.normals[3 * v + 1]),
+                    static_cast<double>(m.normals[3 * v + 2])};
+        ASSERT_TRUE(std::isfinite(n[0]) && std::isfinite(n[1]) && std::isfinite(n[2])) << what << ", vertex " << v;
+        ASSERT_NEAR(std::sqrt(dot(n, n)), 1.0, 1e-6) << what << ", vertex " << v;
+        ++counts.vertices;
+        const double l = std::sqrt(dot(sum[v], sum[v]));
+        if (l < 0.1 * area[v]) ++counts.faint;
+        if (l > 1e-6 * area[v]) {
+            EXPECT_GT(dot(n, sum[v]) / l, 0.9999) << what << ", vertex " << v;
+        }
+    }
+}
+
+// label_surface()'s vertex i is the interface's vertex from[i] (its triangles in interface order,
+// the second and third corners swapped where the label is in front).
+std::vector<std::uint32_t> interface_vertices(const LabelSurfaces& s, std::int64_t label, const Mesh& m)
+{
+    std::vector<std::uint32_t> from(m.vertex_count());
+    std::size_t i = 0;
+    for (std::size_t t = 0; t < s.interfaces.triangle_count(); ++t) {
+        if (s.front[t] != label && s.behind[t] != label) continue;
+        const bool in_front = s.front[t] == label;
+        const std::uint32_t* c = &s.interfaces.triangles[3 * t];
+        from[m.triangles[3 * i]] = c[0];
+        from[m.triangles[3 * i + 1]] = c[in_front ? 2 : 1];
+        from[m.triangles[3 * i + 2]] = c[in_front ? 1 : 2];
+        ++i;
+    }
+    return from;
+}
+
+// Normals (LabelOptions::normals): unit and finite everywhere, on the faces' side; at a vertex only
+// two labels share, the two surfaces' normals are exact negations and the interface's is the lower
+// label's (pointing into the higher, the front); in a rotated, mirroring and scaled frame too.
+TEST(Labels, Normals)
+{
+    NormalCounts counts;
+    for (const int labels : {2, 3, 4})
+        for (const bool smooth : {false, true})
+            for (const std::uint64_t seed : {1U, 2U, 3U}) {
+                Volume v = label_checks::random_labels(static_cast<std::int64_t>(5 + seed), labels, seed, smooth);
+                if (seed == 2) v.set_direction({{{0.6, 0.8, 0}, {-0.8, 0.6, 0}, {0, 0, 1}}});
+                if (seed == 3) {
+                    v.set_direction({{{-1, 0, 0}, {0, 1, 0}, {0, 0, 1}}});
+                    v.set_spacing({0.5, 2, 1});
+                }
+                const std::string what = std::to_string(labels) + " labels, " + (smooth ? "smooth" : "i.i.d.") +
+                                         ", seed " + std::to_string(seed);
+                LabelOptions o;
+                o.normals = true;
+                const LabelSurfaces s = label_surfaces(v, o);
+                const Mesh& all = s.interfaces;
+                ASSERT_GT(all.triangle_count(), 0U) << what;
+                expect_unit_and_with_the_faces(all, what + ", interfaces", counts);
+                // the labels at each interface vertex
+                std::vector<std::vector<std::int64_t>> around(all.vertex_count());
+                for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+                    EXPECT_GT(s.front[t], s.behind[t]) << what << ", triangle " << t;
+                    for (std::size_t c = 0; c < 3; ++c)
+                        for (const std::int64_t l : {s.front[t], s.behind[t]}) {
+                            auto& a = around[all.triangles[3 * t + c]];
+                            if (std::find(a.begin(), a.end(), l) == a.end()) a.push_back(l);
+                        }
+                }
+                // each two-label vertex's normal in the lower label's surface, then in the higher's
+                std::vector<std::array<float, 3>> lower(all.vertex_count());
+                std::vector<char> seen(all.vertex_count(), 0);
+                for (const std::int64_t l : s.selected) {
+                    const Mesh m = label_surface(s, l);
+                    expect_unit_and_with_the_faces(m, what + ", label " + std::to_string(l), counts);
+                    const std::vector<std::uint32_t> from = interface_vertices(s, l, m);
+                    for (std::size_t i = 0; i < m.vertex_count(); ++i) {
+                        const std::uint32_t u = from[i];
+                        if (around[u].size() != 2) continue;
+                        const std::array<float, 3> n{m.normals[3 * i], m.normals[3 * i + 1], m.normals[3 * i + 2]};
+                        if (l == std::min(around[u][0], around[u][1])) {
+                            lower[u] = n;
+                            seen[u] = 1;
+                            for (std::size_t k = 0; k < 3; ++k)
+                                EXPECT_EQ(n[k], all.normals[3 * u + k]) << what << ", vertex " << u;
+                            continue;
+                        }
+                        ASSERT_TRUE(seen[u]) << what << ", vertex " << u;
+                        ++counts.two_label;
+                        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(n[k], -lower[u][k]) << what << ", vertex " << u;
+                    }
+                }
+            }
+    std::cout << counts.vertices << " label surface and interface vertices, " << counts.faint
+              << " where the faces' normals nearly cancel, " << counts.two_label << " shared by two labels\n";
+    EXPECT_GT(counts.two_label, 1000);
+}
+
+// Without LabelOptions::normals nothing has normals.
+TEST(Labels, NoNormalsUnlessAsked)
+{
+    const Volume v = label_checks::random_labels(7, 3, 4, true);
+    const LabelSurfaces s = label_surfaces(v);
+    EXPECT_FALSE(s.interfaces.has_normals());
+    for (const std::int64_t l : s.selected) EXPECT_FALSE(label_surface(s, l).has_normals());
 }
 
 TEST(Labels, UniformAndFlatVolumes)

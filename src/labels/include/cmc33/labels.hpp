@@ -36,13 +36,18 @@ struct LabelOptions {
     LabelRanges labels{};
     /// Threads of the cell pass (z-ranges); 0: all cores. The output is the same for every count.
     int threads = 0;
+    /// Per-vertex unit normals on `interfaces` (and so on every label_surface()): at each vertex the
+    /// area-weighted mean of its triangles' normals, as each mesh is wound (docs/labels.md).
+    bool normals = false;
 };
 
 /// The interfaces of a label map, in world coordinates as extract() places vertices (the volume's
 /// origin, spacing and direction).
 struct LabelSurfaces {
     /// Every interface triangle that has a selected label on a side, once. Its normal (counter-
-    /// clockwise winding) points into `front`. Vertices are shared: welded by grid position.
+    /// clockwise winding) points into `front`, the higher of its two labels. Vertices are shared:
+    /// welded by grid position. With LabelOptions::normals, per-vertex normals pointing to `front`
+    /// (at a vertex where more than two labels meet: the mean of the triangles there).
     Mesh interfaces;
     std::vector<std::int64_t> front, behind; ///< one label per triangle of `interfaces`
     std::vector<std::int64_t> present;       ///< every label value in the volume, ascending
@@ -61,7 +66,9 @@ CMC33_LABELS_EXPORT LabelSurfaces label_surfaces(const Volume& labels, const Lab
 
 /// The closed surface of `label` (closed except where it meets the volume's box): the interface
 /// triangles with `label` on a side, wound so that normals point out of the label's region,
-/// with only the vertices they use. Empty for a label that is not in `selected`.
+/// with only the vertices they use. Empty for a label that is not in `selected`. When `interfaces`
+/// has normals, the surface has its own, pointing out of the label: at a vertex only two labels
+/// share, the exact negation of the other label's.
 CMC33_LABELS_EXPORT Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label);
 
 } // namespace cmc33
