@@ -33,6 +33,7 @@ struct LabelsArgs {
     std::int64_t background = 0;
     std::string format = "ply";
     bool json = false;
+    bool normals = false;
     int threads = 0;
     RawVolumeOptions raw;
 };
@@ -60,6 +61,7 @@ void run_labels(const LabelsArgs& args)
     LabelOptions options;
     options.background = args.background;
     options.threads = args.threads;
+    options.normals = args.normals;
     try {
         options.labels = parse_label_ranges(args.labels);
     } catch (const Error& e) {
@@ -68,14 +70,14 @@ void run_labels(const LabelsArgs& args)
     const bool scene = (args.output.ends_with(".glb") || args.output.ends_with(".gltf")) && !fs::is_directory(args.output);
     const bool single = (scene || args.output.ends_with(".ply")) && !fs::is_directory(args.output);
     if (single) {
-        check_mesh_output(args.output, false, false, {args.input});
+        check_mesh_output(args.output, false, args.normals, {args.input});
     } else {
         // a folder, made if missing (its parent must exist); every file is named label_<value>.<format>
         const fs::path folder(args.output);
         const bool exists = fs::is_directory(folder);
         if (!exists && fs::exists(folder)) throw UsageError("-o " + args.output + ": not a folder or a .ply file");
         const fs::path where = exists ? folder : (folder.parent_path().empty() ? fs::path(".") : folder.parent_path());
-        check_mesh_output((where / ("label_0." + args.format)).string(), false, false, {args.input});
+        check_mesh_output((where / ("label_0." + args.format)).string(), false, args.normals, {args.input});
     }
     const Volume volume = load_volume(args.input, args.raw);
     const LabelSurfaces s =
@@ -171,6 +173,9 @@ void add_labels(CLI::App& app)
                     "Format of a folder's files: ply (default), obj, stl, off, glb, gltf, vtp, gii")
         ->type_name("EXT")
         ->check(CLI::IsMember({"ply", "obj", "stl", "off", "glb", "gltf", "vtp", "gii"}));
+    cmd->add_flag("--normals", args->normals,
+                  "Per-vertex normals: each label's pointing out of it, the interfaces' to the front label "
+                  "(area-weighted triangle normals; not in .off or .stl)");
     cmd->add_flag("--json", args->json, "Print one JSON object: every label's file, size, topology and embedding");
     cmd->add_option("--threads", args->threads,
                     "Threads of the surfaces and the --json checks, 0 = all cores (the same files for any count)")
@@ -188,7 +193,7 @@ void add_labels(CLI::App& app)
                 "  cmc33 labels seg.nrrd -o meshes/ --json\n"
                 "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
                 "  cmc33 labels seg.nrrd -o interfaces.ply\n"
-                "  cmc33 labels seg.nrrd -o organs.glb");
+                "  cmc33 labels seg.nrrd -o organs.glb --normals");
     cmd->callback([args] { run_labels(*args); });
 }
 

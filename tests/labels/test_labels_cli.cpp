@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <sys/wait.h>
 
 #include "cmc33/io.hpp"
@@ -52,6 +53,62 @@ TEST(LabelsCli, FolderAndInterfaces)
     EXPECT_EQ(a, test::read_file(dir / "j.ply"));
     EXPECT_NE(a.find("property int front"), std::string::npos);
     EXPECT_EQ(io::read_mesh(dir / "i.ply").triangle_count(), s.interfaces.triangle_count());
+}
+
+// --normals: each label's file and the interfaces' PLY carry the library's normals, byte for byte
+// in the PLY (binary floats); formats without normals are refused before any work.
+TEST(LabelsCli, Normals)
+{
+    const fs::path dir = test::temp_dir();
+    const Volume seg = label_checks::random_labels(8, 3, 6, true);
+    io::write_volume(seg, dir / "seg.nrrd");
+    LabelOptions o;
+    o.normals = true;
+    const LabelSurfaces s = label_surfaces(seg, o);
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --normals",
+                  dir / "err"),
+              0)
+        << test::read_file(dir / "err");
+    for (const std::int64_t l : s.selected) {
+        const Mesh m = io::read_mesh(dir / "out" / ("label_" + std::to_string(l) + ".ply"));
+        const Mesh want = label_surface(s, l);
+        ASSERT_TRUE(m.has_normals()) << l;
+        EXPECT_TRUE(m.normals == want.normals) << l;
+    }
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "i.ply").string() + " --normals",
+                  dir / "err"),
+              0)
+        << test::read_file(dir / "err");
+    const Mesh i = io::read_mesh(dir / "i.ply");
+    EXPECT_TRUE(i.normals == s.interfaces.normals);
+    // the other writers that store normals (OBJ read back; VTP and glTF by their normals' tags)
+    for (const auto& [format, tag] : {std::pair{"obj", ""}, std::pair{"vtp", "Normals=\"Normals\""},
+                                      std::pair{"glb", "\"NORMAL\""}, std::pair{"gii", "NIFTI_INTENT_VECTOR"}}) {
+        const fs::path out = dir / (std::string("f_") + format);
+        ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + out.string() + " --normals --format " + format,
+                      dir / "err"),
+                  0)
+            << format << ": " << test::read_file(dir / "err");
+        const fs::path file = out / (std::string("label_1.") + format);
+        if (std::string(format) == "obj") {
+            const Mesh m = io::read_mesh(file), want = label_surface(s, 1);
+            ASSERT_EQ(m.normals.size(), want.normals.size());
+            for (std::size_t k = 0; k < m.normals.size(); ++k) ASSERT_NEAR(m.normals[k], want.normals[k], 1e-6) << k;
+        } else {
+            EXPECT_NE(test::read_file(file).find(tag), std::string::npos) << format;
+        }
+    }
+    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "s.glb").string() + " --normals",
+                  dir / "err"),
+              0)
+        << test::read_file(dir / "err");
+    EXPECT_NE(test::read_file(dir / "s.glb").find("\"NORMAL\""), std::string::npos);
+    EXPECT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "stl").string() + " --normals --format stl",
+                  dir / "err"),
+              2);
+    const std::string err = test::read_file(dir / "err");
+    EXPECT_NE(err.find("cannot store normals"), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(dir / "stl"));
 }
 
 TEST(LabelsCli, InterfaceLabelsPastInt32AreUint)
