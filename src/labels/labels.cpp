@@ -460,52 +460,62 @@ Normal face_normal(const Mesh& m, std::size_t t)
 
 double length(const Normal& n) { return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); }
 
-// Unit normals of `vertices` vertices: the sum of the normals `face(i)` (twice the area long) of
-// the triangles `corners(i)`, i < `triangles`, at each vertex, summed in triangle order so that the
-// bytes depend on nothing else. Where the sum vanishes against the areas (triangles that cancel)
-// the vertex takes its largest triangle's normal (the first of equals), and where it has only
-// zero-area triangles (0, 0, up(v)): finite and unit everywhere. A surface whose faces are another's
-// negated, in the same order, gets exactly the negated normals.
-template <class Corners, class Face, class Up>
-Buffer<float> vertex_normals(std::size_t vertices, std::size_t triangles, Corners&& corners, Face&& face, Up&& up)
+// Unit normals into `out` (3 floats per vertex) of the vertices v with wanted(v): the sum of the
+// normals `face(i)` (twice the area long) of the triangles `corners(i)`, i < `triangles`, at each,
+// summed in triangle order so that the bytes depend on nothing else. Where the sum vanishes against
+// the areas (triangles that cancel) the vertex takes its largest triangle's normal (the first of
+// equals), and where it has only zero-area triangles (0, 0, up(v)): finite and unit everywhere.
+// Faces negated in the same order give exactly the negated normals (rounding is symmetric).
+template <class Corners, class Face, class Up, class Wanted>
+void vertex_normals(Buffer<float>& out, std::size_t vertices, std::size_t triangles, Corners&& corners, Face&& face,
+                    Up&& up, Wanted&& wanted)
 {
-    std::vector<std::array<double, 4>> sum(vertices, {0, 0, 0, 0}); // the normals' sum, their lengths' sum
+    // floats, summed into the output: a quarter of the memory traffic of doubles, and a few
+    // triangles' sum keeps float precision
+    Buffer<float> area(vertices);
+    for (std::size_t v = 0; v < vertices; ++v) {
+        if (!wanted(v)) continue;
+        out[3 * v] = out[3 * v + 1] = out[3 * v + 2] = area[v] = 0;
+    }
     for (std::size_t i = 0; i < triangles; ++i) {
+        const std::array<std::uint32_t, 3> c = corners(i);
+        if (!wanted(c[0]) && !wanted(c[1]) && !wanted(c[2])) continue;
         const Normal n = face(i);
-        const double l = length(n);
-        for (const std::uint32_t v : corners(i)) {
-            auto& s = sum[v];
-            s[0] += n[0];
-            s[1] += n[1];
-            s[2] += n[2];
-            s[3] += l;
+        const std::array<float, 3> f{static_cast<float>(n[0]), static_cast<float>(n[1]), static_cast<float>(n[2])};
+        const float l = static_cast<float>(length(n));
+        for (const std::uint32_t v : c) {
+            if (!wanted(v)) continue;
+            float* o = &out[3 * v];
+            o[0] += f[0];
+            o[1] += f[1];
+            o[2] += f[2];
+            area[v] += l;
         }
     }
-    Buffer<float> out(3 * vertices);
     std::vector<std::uint32_t> degenerate;
     for (std::size_t v = 0; v < vertices; ++v) {
-        const auto& s = sum[v];
-        const double l = length({s[0], s[1], s[2]});
+        if (!wanted(v)) continue;
+        float* o = &out[3 * v];
+        const double l = length({static_cast<double>(o[0]), static_cast<double>(o[1]), static_cast<double>(o[2])});
         // relative to the areas, so that rounding left by cancelling triangles is no direction
-        if (!(l > 1e-9 * s[3]) || !(l > 0) || !std::isfinite(l)) {
+        if (!(l > 1e-4 * static_cast<double>(area[v])) || !(l > 0) || !std::isfinite(l)) {
             degenerate.push_back(static_cast<std::uint32_t>(v));
             continue;
         }
-        for (std::size_t k = 0; k < 3; ++k) out[3 * v + k] = static_cast<float>(s[k] / l);
+        for (std::size_t k = 0; k < 3; ++k) o[k] = static_cast<float>(static_cast<double>(o[k]) / l);
     }
-    if (degenerate.empty()) return out;
+    if (degenerate.empty()) return;
     std::vector<std::uint32_t> slot(vertices, kNone);
     for (std::size_t d = 0; d < degenerate.size(); ++d) slot[degenerate[d]] = static_cast<std::uint32_t>(d);
     std::vector<Normal> best(degenerate.size(), Normal{0, 0, 0});
     std::vector<double> best_length(degenerate.size(), 0);
     for (std::size_t i = 0; i < triangles; ++i) {
-        bool any = false;
-        for (const std::uint32_t v : corners(i)) any = any || slot[v] != kNone;
-        if (!any) continue;
+        const std::array<std::uint32_t, 3> c = corners(i);
+        if (slot[c[0]] == kNone && slot[c[1]] == kNone && slot[c[2]] == kNone) continue;
         const Normal n = face(i);
         const double l = length(n);
         if (!std::isfinite(l)) continue;
-        for (const std::uint32_t v : corners(i)) {
+        for (const std::uint32_t v : c) {
             if (slot[v] == kNone || !(l > best_length[slot[v]])) continue;
             best[slot[v]] = n;
             best_length[slot[v]] = l;
@@ -518,7 +528,34 @@ Buffer<float> vertex_normals(std::size_t vertices, std::size_t triangles, Corner
             out[3 * v + k] = l > 0 ? static_cast<float>(best[d][k] / l) : (k == 2 ? static_cast<float>(up(v)) : 0.0F);
         }
     }
-    return out;
+}
+
+// The interfaces' normals, and which vertices have triangles of more than one pair of labels.
+void interface_normals(LabelSurfaces& s)
+{
+    Mesh& m = s.interfaces;
+    const std::size_t nv = m.vertex_count(), nt = m.triangle_count();
+    Buffer<std::uint32_t> first(nv);
+    std::fill(first.begin(), first.end(), kNone);
+    s.junctions.assign(nv, 0);
+    for (std::size_t t = 0; t < nt; ++t) {
+        for (std::size_t c = 0; c < 3; ++c) {
+            const std::uint32_t v = m.triangles[3 * t + c];
+            if (first[v] == kNone) {
+                first[v] = static_cast<std::uint32_t>(t);
+            } else if (s.front[first[v]] != s.front[t] || s.behind[first[v]] != s.behind[t]) {
+                s.junctions[v] = 1;
+            }
+        }
+    }
+    m.normals.resize(3 * nv);
+    vertex_normals(
+        m.normals, nv, nt,
+        [&](std::size_t t) {
+            return std::array<std::uint32_t, 3>{m.triangles[3 * t], m.triangles[3 * t + 1], m.triangles[3 * t + 2]};
+        },
+        [&](std::size_t t) { return face_normal(m, t); }, [](std::size_t) { return 1.0; },
+        [](std::size_t) { return true; });
 }
 
 // Counts, offsets, fill: the triangles of each selected label in ascending order.
@@ -582,15 +619,7 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
     }
     // with many labels, finding each one's triangles by a scan of all would cost labels x triangles
     if (out.selected.size() > 8 && out.front.size() < kNone) index_by_label(out);
-    if (options.normals) {
-        const Mesh& m = out.interfaces;
-        out.interfaces.normals = vertex_normals(
-            m.vertex_count(), m.triangle_count(),
-            [&](std::size_t t) {
-                return std::array<std::uint32_t, 3>{m.triangles[3 * t], m.triangles[3 * t + 1], m.triangles[3 * t + 2]};
-            },
-            [&](std::size_t t) { return face_normal(m, t); }, [](std::size_t) { return 1.0; });
-    }
+    if (options.normals && out.front.size() < kNone) interface_normals(out);
     return out;
 }
 
@@ -691,33 +720,45 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
     } else {
         remap.assign(all.vertex_count(), kNone);
     }
-    const auto use = [&](std::uint32_t v) {
+    // normals: at a vertex of one pair of labels the interfaces' (the lower label's: the same sum),
+    // negated where the label is in front; at a junction the label's own sum, from the interface
+    // triangles' normals negated where it is in front (exactly the other side's negation), with
+    // the first triangle's side as the last resort's direction
+    const bool normals = all.has_normals();
+    const bool flagged = surfaces.junctions.size() == all.vertex_count();
+    std::vector<signed char> own; // per vertex: 0 the interfaces' normal, else the last resort's side
+    if (normals) {
+        out.normals.reserve(3 * most);
+        own.reserve(most);
+    }
+    const auto use = [&](std::uint32_t v, bool in_front) {
         std::uint32_t& id =
             few ? remap[static_cast<std::size_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin())]
                 : remap[v];
         if (id == kNone) {
             id = static_cast<std::uint32_t>(out.positions.size() / 3);
             for (std::size_t a = 0; a < 3; ++a) out.positions.push_back(all.positions[3 * v + a]);
+            if (normals) {
+                const bool junction = !flagged || surfaces.junctions[v] != 0;
+                const float sign = in_front ? -1.0F : 1.0F;
+                for (std::size_t a = 0; a < 3; ++a) out.normals.push_back(junction ? 0.0F : sign * all.normals[3 * v + a]);
+                own.push_back(junction ? static_cast<signed char>(in_front ? -1 : 1) : 0);
+            }
         }
         out.triangles.push_back(id);
     };
-    // for normals: the side of the first triangle at each vertex (the last resort's direction)
-    std::vector<signed char> first_side;
-    const bool normals = all.has_normals();
-    if (normals) first_side.reserve(most);
+    bool any_junction = false;
     for (const std::size_t t : mine) {
         // normals point into `front`; the label's surface points out of it
         const bool in_front = surfaces.front[t] == label;
-        use(all.triangles[3 * t]);
-        use(all.triangles[3 * t + (in_front ? 2 : 1)]);
-        use(all.triangles[3 * t + (in_front ? 1 : 2)]);
-        if (normals && first_side.size() < out.vertex_count()) first_side.resize(out.vertex_count(), in_front ? -1 : 1);
+        use(all.triangles[3 * t], in_front);
+        use(all.triangles[3 * t + (in_front ? 2 : 1)], in_front);
+        use(all.triangles[3 * t + (in_front ? 1 : 2)], in_front);
     }
-    if (normals) {
-        // the interface triangles' normals turned where the label is in front: exactly the negation
-        // of the other side's, whatever the arithmetic of a turned winding would round to
-        out.normals = vertex_normals(
-            out.vertex_count(), mine.size(),
+    if (normals) any_junction = std::any_of(own.begin(), own.end(), [](signed char o) { return o != 0; });
+    if (any_junction) {
+        vertex_normals(
+            out.normals, out.vertex_count(), mine.size(),
             [&](std::size_t i) {
                 return std::array<std::uint32_t, 3>{out.triangles[3 * i], out.triangles[3 * i + 1],
                                                     out.triangles[3 * i + 2]};
@@ -727,7 +768,7 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
                 if (surfaces.front[mine[i]] == label) n = {-n[0], -n[1], -n[2]};
                 return n;
             },
-            [&](std::size_t v) { return static_cast<double>(first_side[v]); });
+            [&](std::size_t v) { return static_cast<double>(own[v]); }, [&](std::size_t v) { return own[v] != 0; });
     }
     return out;
 }

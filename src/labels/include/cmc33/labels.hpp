@@ -58,6 +58,9 @@ struct LabelSurfaces {
     /// selected[i] on a side are by_label[by_label_start[i] .. by_label_start[i + 1]), ascending.
     std::vector<std::uint32_t> by_label;
     std::vector<std::size_t> by_label_start;
+    /// With normals, per vertex of `interfaces`: 1 where triangles of more than one pair of labels
+    /// meet. label_surface() sums a label's own normals there and turns the interfaces' elsewhere.
+    std::vector<std::uint8_t> junctions;
 };
 
 /// One pass over `labels` (an integer sample type).
