@@ -2,7 +2,7 @@
 """Whole processes on label maps: cmc33 labels beside VTK's vtkDiscreteFlyingEdges3D and one
 cmc33 extract of the same map's foreground (docs/labels.md's targets).
 
-    bench/labels_bench.py [--cmc33 PATH] [--volumes DIR] [--work DIR] [--no-vtk] [--json] [CASE ...]
+    bench/labels_bench.py [--cmc33 PATH] [--volumes DIR] [--work DIR] [--no-vtk] [--without-normals] [--json] [CASE ...]
 
 Makes the label maps from the shared volumes (kept in --work, made once), as uint8/uint16 NRRD:
   CThead    tissue classes by thresholds 600 and 1400 (as tests/labels/test_labels_volumes.cpp)
@@ -10,8 +10,9 @@ Makes the label maps from the shared volumes (kept in --work, made once), as uin
   bonsai    classes by thresholds 40.5 (tree) and 150.5 (pot and soil), run_bench.py's isovalues
 and runs each of these in its own process, once, timed from start to exit (wall time) with its
 peak resident memory:
-  labels-1   cmc33 labels SEG -o DIR --threads 1      (every label but 0, one PLY per label)
-  labels     cmc33 labels SEG -o DIR                  (threads: all cores)
+  labels-1   cmc33 labels SEG -o DIR --normals --threads 1   (every label but 0, one PLY per label)
+  labels     cmc33 labels SEG -o DIR --normals                (threads: all cores)
+             (--without-normals drops --normals, to see what the normals cost)
   vtk-1      python3: vtkNrrdReader -> vtkDiscreteFlyingEdges3D (every label but 0, ComputeNormals
              on) -> vtkPLYWriter (binary, one file), vtkSMPTools at 1 thread
   vtk        the same at VTK's default thread count (all cores)
@@ -133,6 +134,8 @@ def main(argv):
     p.add_argument("--volumes", default=os.path.join(REPO, "..", "shared", "data", "volumes"), help="the real volumes")
     p.add_argument("--work", default=os.path.join(REPO, "bench-work"), help="where the label maps are kept")
     p.add_argument("--no-vtk", action="store_true", help="leave VTK out")
+    p.add_argument("--without-normals", action="store_true",
+                   help="cmc33 labels without --normals (VTK and extract keep theirs)")
     p.add_argument("--json", action="store_true", help="one JSON line per case and tool instead of the table")
     args = p.parse_args(argv)
     for c in args.cases:
@@ -141,6 +144,8 @@ def main(argv):
     if not os.access(args.cmc33, os.X_OK):
         die(f"{args.cmc33} is not an executable; build cmc33 or pass --cmc33 PATH")
     python = "/usr/bin/python3"
+    # issue #39's target is stated with normals on, as VTK computes them
+    normals = [] if args.without_normals else ["--normals"]
     tools = list(TOOLS)
     notes = []
     if args.no_vtk:
@@ -160,8 +165,8 @@ def main(argv):
                     pass
             out_dir, out_ply = os.path.join(tmp, "labels"), os.path.join(tmp, "out.ply")
             commands = {
-                "labels-1": [args.cmc33, "labels", seg, "-o", out_dir, "--threads", "1"],
-                "labels": [args.cmc33, "labels", seg, "-o", out_dir],
+                "labels-1": [args.cmc33, "labels", seg, "-o", out_dir, "--threads", "1"] + normals,
+                "labels": [args.cmc33, "labels", seg, "-o", out_dir] + normals,
                 "vtk-1": [python, "-c", VTK_CHILD, seg, out_ply, "1"] + present,
                 "vtk": [python, "-c", VTK_CHILD, seg, out_ply, "0"] + present,
                 "extract-1": [args.cmc33, "extract", seg, "--iso", "0.5", "--normals", "-o", out_ply, "--threads", "1"],
@@ -195,13 +200,13 @@ def main(argv):
             print(json.dumps(rec))
     else:
         meta = machine(os.path.dirname(os.path.dirname(os.path.abspath(args.cmc33))), 1, False, os.cpu_count() or 1)
-        print(table(records, args.cases or list(CASES), meta, notes), end="")
+        print(table(records, args.cases or list(CASES), meta, notes, not args.without_normals), end="")
     if failed:
         die(f"{failed} run(s) failed; the table names them")
     return 0
 
 
-def table(records, cases, meta, notes):
+def table(records, cases, meta, notes, normals):
     def find(case, tool):
         return next((r for r in records if r["case"] == case and r["tool"] == tool and "seconds" in r), None)
 
@@ -228,7 +233,8 @@ def table(records, cases, meta, notes):
                                   for t in ("labels-1", "vtk-1", "extract-1"))
                      + f" | {ratio(r['labels-1'], r['vtk-1'], 'cpu_seconds')}, "
                      f"{ratio(r['labels-1'], r['extract-1'], 'cpu_seconds')} |")
-    lines += ["", "labels: `cmc33 labels SEG -o DIR` (one binary PLY per label but 0, no normals); VTK: "
+    lines += ["", f"labels: `cmc33 labels SEG -o DIR{' --normals' if normals else ''}` (one binary PLY per label "
+              f"but 0, {'with' if normals else 'no'} normals); VTK: "
               "vtkNrrdReader -> vtkDiscreteFlyingEdges3D (every label but 0, ComputeNormals) -> vtkPLYWriter "
               "(binary, one file) in python3; extract: `cmc33 extract SEG --iso 0.5 --normals -o out.ply` "
               "(the foreground). 1 thr: `--threads 1`, vtkSMPTools.Initialize(1). CPU s: user + system time of the "
