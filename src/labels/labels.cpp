@@ -704,9 +704,11 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
             if (surfaces.front[t] == label || surfaces.behind[t] == label) mine.push_back(t);
         }
     }
-    out.triangles.reserve(3 * mine.size());
+    // sized for the most and written by index (a push_back per float was a tenth of the command's
+    // time), cut to what was used at the end; pages never written are never touched
+    out.triangles.resize(3 * mine.size());
     const std::size_t most = std::min(all.vertex_count(), 3 * mine.size());
-    out.positions.reserve(3 * most);
+    out.positions.resize(3 * most);
     // vertices numbered in order of first use, through an array over all vertices, or for a label
     // with few of them (one of many) through the sorted list of those it uses
     std::vector<std::uint32_t> used, remap;
@@ -726,28 +728,35 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
     // the first triangle's side as the last resort's direction
     const bool normals = all.has_normals();
     const bool flagged = surfaces.junctions.size() == all.vertex_count();
-    std::vector<signed char> own; // per vertex: 0 the interfaces' normal, else the last resort's side
+    Buffer<signed char> own; // per vertex: 0 the interfaces' normal, else the last resort's side
     if (normals) {
-        out.normals.reserve(3 * most);
-        own.reserve(most);
+        out.normals.resize(3 * most);
+        own.resize(most);
     }
+    std::size_t vertices = 0, corner = 0;
+    float* const position = out.positions.data();
+    float* const normal = out.normals.data();
+    std::uint32_t* const triangle = out.triangles.data();
+    bool any_junction = false;
     const auto use = [&](std::uint32_t v, bool in_front) {
         std::uint32_t& id =
             few ? remap[static_cast<std::size_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin())]
                 : remap[v];
         if (id == kNone) {
-            id = static_cast<std::uint32_t>(out.positions.size() / 3);
-            for (std::size_t a = 0; a < 3; ++a) out.positions.push_back(all.positions[3 * v + a]);
+            id = static_cast<std::uint32_t>(vertices);
+            for (std::size_t a = 0; a < 3; ++a) position[3 * vertices + a] = all.positions[3 * v + a];
             if (normals) {
                 const bool junction = !flagged || surfaces.junctions[v] != 0;
                 const float sign = in_front ? -1.0F : 1.0F;
-                for (std::size_t a = 0; a < 3; ++a) out.normals.push_back(junction ? 0.0F : sign * all.normals[3 * v + a]);
-                own.push_back(junction ? static_cast<signed char>(in_front ? -1 : 1) : 0);
+                for (std::size_t a = 0; a < 3; ++a)
+                    normal[3 * vertices + a] = junction ? 0.0F : sign * all.normals[3 * v + a];
+                own[vertices] = junction ? static_cast<signed char>(in_front ? -1 : 1) : 0;
+                any_junction = any_junction || junction;
             }
+            ++vertices;
         }
-        out.triangles.push_back(id);
+        triangle[corner++] = id;
     };
-    bool any_junction = false;
     for (const std::size_t t : mine) {
         // normals point into `front`; the label's surface points out of it
         const bool in_front = surfaces.front[t] == label;
@@ -755,7 +764,8 @@ Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
         use(all.triangles[3 * t + (in_front ? 2 : 1)], in_front);
         use(all.triangles[3 * t + (in_front ? 1 : 2)], in_front);
     }
-    if (normals) any_junction = std::any_of(own.begin(), own.end(), [](signed char o) { return o != 0; });
+    out.positions.resize(3 * vertices);
+    if (normals) out.normals.resize(3 * vertices);
     if (any_junction) {
         vertex_normals(
             out.normals, out.vertex_count(), mine.size(),
