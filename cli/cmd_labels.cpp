@@ -67,7 +67,8 @@ void run_labels(const LabelsArgs& args)
     } catch (const Error& e) {
         throw UsageError(std::string("--") + e.what());
     }
-    const bool scene = (args.output.ends_with(".glb") || args.output.ends_with(".gltf")) && !fs::is_directory(args.output);
+    const bool scene =
+        (args.output.ends_with(".glb") || args.output.ends_with(".gltf")) && !fs::is_directory(args.output);
     const bool single = (scene || args.output.ends_with(".ply")) && !fs::is_directory(args.output);
     if (single) {
         check_mesh_output(args.output, false, args.normals, {args.input});

@@ -458,7 +458,10 @@ Normal face_normal(const Mesh& m, std::size_t t)
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-double length(const Normal& n) { return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]); }
+double length(const Normal& n)
+{
+    return std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+}
 
 // Unit normals into `out` (3 floats per vertex) of the vertices v with wanted(v): the sum of the
 // normals `face(i)` (twice the area long) of the triangles `corners(i)`, i < `triangles`, at each,

@@ -231,12 +231,15 @@ Vec face_normal(const Mesh& m, std::size_t t)
     return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
 }
 
-double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+double dot(const Vec& a, const Vec& b)
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
 
 struct NormalCounts {
-    std::int64_t vertices = 0;   ///< label surfaces' vertices checked
-    std::int64_t faint = 0;      ///< where the faces' sum is under a tenth of their areas (pinches)
-    std::int64_t two_label = 0;  ///< label surfaces' vertices that only two labels share
+    std::int64_t vertices = 0;  ///< label surfaces' vertices checked
+    std::int64_t faint = 0;     ///< where the faces' sum is under a tenth of their areas (pinches)
+    std::int64_t two_label = 0; ///< label surfaces' vertices that only two labels share
 };
 
 // Every normal of `m` finite and unit, and on the side of the area-weighted sum of its faces'

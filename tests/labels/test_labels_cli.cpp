@@ -8,8 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <string>
-#include <utility>
 #include <sys/wait.h>
+#include <utility>
 
 #include "cmc33/io.hpp"
 #include "cmc33/labels.hpp"
@@ -65,9 +65,8 @@ TEST(LabelsCli, Normals)
     LabelOptions o;
     o.normals = true;
     const LabelSurfaces s = label_surfaces(seg, o);
-    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --normals",
-                  dir / "err"),
-              0)
+    ASSERT_EQ(
+        run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "out").string() + " --normals", dir / "err"), 0)
         << test::read_file(dir / "err");
     for (const std::int64_t l : s.selected) {
         const Mesh m = io::read_mesh(dir / "out" / ("label_" + std::to_string(l) + ".ply"));
@@ -75,9 +74,8 @@ TEST(LabelsCli, Normals)
         ASSERT_TRUE(m.has_normals()) << l;
         EXPECT_TRUE(m.normals == want.normals) << l;
     }
-    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "i.ply").string() + " --normals",
-                  dir / "err"),
-              0)
+    ASSERT_EQ(
+        run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "i.ply").string() + " --normals", dir / "err"), 0)
         << test::read_file(dir / "err");
     const Mesh i = io::read_mesh(dir / "i.ply");
     EXPECT_TRUE(i.normals == s.interfaces.normals);
@@ -98,9 +96,8 @@ TEST(LabelsCli, Normals)
             EXPECT_NE(test::read_file(file).find(tag), std::string::npos) << format;
         }
     }
-    ASSERT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "s.glb").string() + " --normals",
-                  dir / "err"),
-              0)
+    ASSERT_EQ(
+        run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "s.glb").string() + " --normals", dir / "err"), 0)
         << test::read_file(dir / "err");
     EXPECT_NE(test::read_file(dir / "s.glb").find("\"NORMAL\""), std::string::npos);
     EXPECT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "stl").string() + " --normals --format stl",
