@@ -42,15 +42,7 @@ void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, cons
     if ((c.vertices_ > 0 && out.positions == nullptr) || (c.triangles_ > 0 && out.triangles == nullptr)) {
         throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
     }
-    const bool block = out.whole_dims != Index3{0, 0, 0};
-    const Emit e{c,
-                 off,
-                 out,
-                 gradient_scale(c.largest_sample_),
-                 block ? min_crossing(out.whole_dims, g_.origin, m_) : delta_,
-                 {out.index_offset[0], out.index_offset[1], out.index_offset[2]},
-                 block ? out.whole_dims[0] : nx_,
-                 block ? out.whole_dims[1] : ny_};
+    const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
     Scratch s(nx_, ny_);
     if (out.vertex_cell_ranges) s.ranges.emplace(nx_, ny_);
     std::size_t decision = 0; // the next of count's decisions
@@ -381,15 +373,11 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std
     const MeshSpans& out = e.out;
     const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
     const T a = at(i, j, k), b = at(end[0], end[1], end[2]);
-    const double t = crossing(a, b, e.delta);
-    // the larger grid's index (MeshSpans::index_offset): p + t sums as its extract() does
-    const double p[3] = {static_cast<double>(i + e.offset[0]), static_cast<double>(j + e.offset[1]),
-                         static_cast<double>(k + e.offset[2])};
-    double x[3];
-    for (int c = 0; c < 3; ++c) x[c] = p[c] + (c == axis ? t : 0.0);
+    const double t = crossing(a, b);
+    const double u[3] = {axis == 0 ? t : 0.0, axis == 1 ? t : 0.0, axis == 2 ? t : 0.0};
     const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
     const bool zyx = kOut == Outputs::drop_in || (kOut == Outputs::all && out.zyx);
-    write_position(x, &out.positions[v * 3], zyx);
+    write_position(i, j, k, u, &out.positions[v * 3], zyx);
     if (out.normals && !write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx)) {
         // central differences cancel (alternating samples): the interpolant's own gradient,
         // never 0 on a crossed edge
@@ -403,7 +391,7 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std
         }
     }
     if constexpr (kOut == Outputs::all) {
-        if (out.vertex_edges) out.vertex_edges[v] = 3 * e.whole_cell(i, j, k) + axis;
+        if (out.vertex_edges) out.vertex_edges[v] = 3 * whole_cell(i, j, k) + axis;
         if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
         if (out.vertex_values) {
             const double va = static_cast<double>(a), vb = static_cast<double>(b);
@@ -467,7 +455,7 @@ void RangeExtractor<T>::emit_row_cells(std::int64_t j, std::int64_t k, const Row
         }
         if constexpr (kOut == Outputs::all) {
             if (out.triangle_cells) {
-                const std::int64_t cell = e.whole_cell(i, j, k);
+                const std::int64_t cell = whole_cell(i, j, k);
                 for (int q = 0; q < count; ++q) out.triangle_cells[t0 + static_cast<std::size_t>(q)] = cell;
             }
         }

@@ -114,7 +114,7 @@ void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, co
                                                   "); expected counts from count() on the same grid");
     }
     check_block(grid.dims, out);
-    detail::RangeExtractor<T>(grid, iso, options).emit(counts, offsets, out, nullptr);
+    detail::RangeExtractor<T>(grid, iso, options, {out.index_offset, out.whole_dims}).emit(counts, offsets, out, nullptr);
 }
 
 #define CMC33_INSTANTIATE(T)                                                                                    \

@@ -6,9 +6,9 @@
 //                   scan fixed, with the short-tiling path for small fixed tilings;
 //   vertices.hpp    vertex placement (crossings, interior vertices) and normals (gradients);
 //   bit_rows.hpp    the above-flags as words and what is read from them.
-// What does not depend on the range (the frame, the sign rule, which configurations need the
-// samples) is set up once in the constructor and shared by the ranges, which may run at the same
-// time: every pass is const.
+// What does not depend on the range (the frame, the grid's place in a larger one, the sign rule,
+// which configurations need the samples) is set up once in the constructor and shared by the
+// ranges, which may run at the same time: every pass is const.
 
 #include <algorithm>
 #include <array>
@@ -38,13 +38,21 @@ namespace cmc33::detail {
 /// (cmc33.marching_cubes); all: every extra, each tested at run time.
 enum class Outputs { plain, drop_in, all };
 
+/// A block's place in its larger grid (MeshSpans::index_offset, whole_dims); both zero: the whole.
+struct BlockPlacement {
+    Index3 offset{0, 0, 0};
+    Index3 whole_dims{0, 0, 0};
+};
+
 template <class T> class RangeExtractor {
 public:
-    RangeExtractor(const GridView<T>& g, double iso, const ExtractOptions& opt)
+    /// `block` fixes emit's positions, numbers and crossing margin once (count reads none of it).
+    RangeExtractor(const GridView<T>& g, double iso, const ExtractOptions& opt, const BlockPlacement& block = {})
         : g_(g), iso_(iso), threshold_(iso), method_(opt.method), nx_(g.nx()), ny_(g.ny()), nz_(g.nz()), sx_(g.strides[0]),
           words_((nx_ + 63) / 64), x_valid_(valid_words(words_, nx_ - 1)),
           m_(frame_matrix(g.spacing, g.direction)), diagonal_(is_diagonal(m_)), mirrored_(determinant(m_) < 0),
-          delta_(min_crossing(g.dims, g.origin, m_)), variants_(detail::tables_of(opt.method))
+          offset_(block.offset), whole_(block.whole_dims == Index3{0, 0, 0} ? g.dims : block.whole_dims),
+          delta_(min_crossing(whole_, g.origin, m_)), variants_(detail::tables_of(opt.method))
     {
         for (std::size_t a = 0; a < 3; ++a) {
             step_[a] = diagonal_ ? m_[a][a] : 1.0;
@@ -156,17 +164,6 @@ private:
         const RangeOffsets& off;
         const MeshSpans& out;
         double gradient_scale;
-        /// Crossings lie in [delta, 1 - delta]: delta_, or the larger grid's (MeshSpans::whole_dims)
-        double delta;
-        /// MeshSpans::index_offset, and the larger grid's nx and ny (the grid's own without one):
-        /// positions and the numbers of edges and cells are those of the larger grid's index
-        std::int64_t offset[3];
-        std::int64_t whole_nx, whole_ny;
-        /// The larger grid's number of cell (i, j, k) of this grid (vertex_edges, triangle_cells)
-        std::int64_t whole_cell(std::int64_t i, std::int64_t j, std::int64_t k) const
-        {
-            return (i + offset[0]) + whole_nx * ((j + offset[1]) + whole_ny * (k + offset[2]));
-        }
         /// One past the range's last triangle id: a short tiling's fixed-size copy may write past
         /// its row's triangles into those of the range's next rows, which this thread writes
         /// later, but not past the range's (another thread's, or the end of the caller's output).
@@ -283,9 +280,9 @@ private:
     CMC33_ALWAYS_INLINE void count_row(std::int64_t j, std::int64_t k, Scratch& s, RangeCounts& c,
                                        const Word* const (&rows)[4], const detail::RowSigns (&signs)[4]) const;
 
-    /// The crossing parameter of the edge from sample value a to b, in [delta, 1 - delta]
+    /// The crossing parameter of the edge from sample value a to b, in [delta_, 1 - delta_]
     /// (src/core/placement.hpp: never on a sample, so ties do not collapse triangles).
-    double crossing(T a, T b, double delta) const;
+    double crossing(T a, T b) const;
 
     /// delta of placement.hpp for a grid of `dims` samples at `origin` with index-to-world map m:
     /// 2^-10 of an edge, or more where the output floats cannot tell a point delta along an edge
@@ -293,9 +290,16 @@ private:
     /// edge).
     static double min_crossing(const Index3& dims, const Vec3& origin, const Mat3& m);
 
-    /// The world position of index-space point x (the frame of volume.hpp), rounded to float, as
-    /// (x, y, z) or with `zyx` (MeshSpans) as (z, y, x).
-    CMC33_ALWAYS_INLINE void write_position(const double x[3], float* out, bool zyx) const;
+    /// The world position of unit point u of cell (i, j, k) at the larger grid's index, as floats
+    /// (x, y, z), or (z, y, x) with `zyx` (MeshSpans).
+    CMC33_ALWAYS_INLINE void write_position(std::int64_t i, std::int64_t j, std::int64_t k, const double (&u)[3],
+                                            float* out, bool zyx) const;
+
+    /// The larger grid's number of cell (i, j, k) (MeshSpans::vertex_edges, triangle_cells).
+    std::int64_t whole_cell(std::int64_t i, std::int64_t j, std::int64_t k) const
+    {
+        return (i + offset_[0]) + whole_[0] * ((j + offset_[1]) + whole_[1] * (k + offset_[2]));
+    }
 
     /// out = p, or p reversed (z, y, x) with `zyx`.
     CMC33_ALWAYS_INLINE static void store(const float p[3], float* out, bool zyx)
@@ -394,8 +398,7 @@ private:
     /// critical point), the surface still has a side. Triangles wind with their normals toward the
     /// below side (mc33_tables.hpp), in index space; M^-T takes them to world space as it does
     /// gradients.
-    std::array<double, 3> fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3],
-                                       double delta) const;
+    std::array<double, 3> fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3]) const;
 
     /// The interior vertices of cell (i, j, k)'s tiling, ids from `first` on, placed by
     /// placement.hpp from the cell's crossings; normals interpolate the corners' gradients.
@@ -414,7 +417,9 @@ private:
     double step_[3] = {};      ///< the diagonal of M when diagonal_, else 1 (see gradient())
     double half_inverse_step_[3] = {}; ///< 1 / (2 step_), central differences' factor
     Mat3 normal_map_{};        ///< M^-T, for a non-diagonal M
-    double delta_; ///< crossings lie in [delta_, 1 - delta_] of their edge (the grid's own box)
+    Index3 offset_; ///< BlockPlacement::offset: the larger grid's index of sample (0, 0, 0)
+    Index3 whole_;  ///< the larger grid's dims (the grid's own without a block placement)
+    double delta_;  ///< crossings lie in [delta_, 1 - delta_] of their edge (the larger grid's box)
     /// The method's table set (detail::tables_of): chosen once here, so the passes' loops read one
     /// pointer and nothing in them depends on the method
     const detail::Variant* variants_;

@@ -22,16 +22,16 @@
 namespace cmc33::detail {
 
 template <class T>
-double RangeExtractor<T>::crossing(T a, T b, double delta) const
+double RangeExtractor<T>::crossing(T a, T b) const
 {
     const double va = static_cast<double>(a), vb = static_cast<double>(b);
     const double d = vb - va; // ends differ in sign: vb != va
     if (std::isinf(d)) {
         // |vb - va| passes DBL_MAX (samples near +-1e308): the same ratio on halved values,
         // which cannot overflow; iso lies between va and vb, so |iso - va| <= |vb - va|
-        return detail::clamp_crossing((0.5 * iso_ - 0.5 * va) / (0.5 * vb - 0.5 * va), delta);
+        return detail::clamp_crossing((0.5 * iso_ - 0.5 * va) / (0.5 * vb - 0.5 * va), delta_);
     }
-    return detail::clamp_crossing((iso_ - va) / d, delta);
+    return detail::clamp_crossing((iso_ - va) / d, delta_);
 }
 
 template <class T>
@@ -45,8 +45,12 @@ double RangeExtractor<T>::min_crossing(const Index3& dims, const Vec3& origin, c
 }
 
 template <class T>
-CMC33_ALWAYS_INLINE void RangeExtractor<T>::write_position(const double x[3], float* out, bool zyx) const
+CMC33_ALWAYS_INLINE void RangeExtractor<T>::write_position(std::int64_t i, std::int64_t j, std::int64_t k,
+                                                           const double (&u)[3], float* out, bool zyx) const
 {
+    // the integer index first, then u: one rounding, as the larger grid's own extraction has
+    const double x[3] = {static_cast<double>(i + offset_[0]) + u[0], static_cast<double>(j + offset_[1]) + u[1],
+                         static_cast<double>(k + offset_[2]) + u[2]};
     float p[3];
     if (diagonal_) {
         for (std::size_t c = 0; c < 3; ++c) p[c] = static_cast<float>(g_.origin[c] + step_[c] * x[c]);
@@ -198,14 +202,14 @@ std::array<double, 3> RangeExtractor<T>::cell_gradient(const T (&value)[8], cons
 }
 
 template <class T>
-std::array<double, 3> RangeExtractor<T>::fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q, const double (&pq)[3],
-                                                      double delta) const
+std::array<double, 3> RangeExtractor<T>::fan_gradient(const T (&value)[8], const detail::Tiling& tl, int q,
+                                                      const double (&pq)[3]) const
 {
     double crossings[12][3]; // the crossed edges' points (interior_position reads only those)
     for (int edge = 0; edge < 12; ++edge) {
         const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
         const bool crossed = (static_cast<double>(value[a]) >= iso_) != (static_cast<double>(value[b]) >= iso_);
-        const double t = crossed ? crossing(value[a], value[b], delta) : 0.5;
+        const double t = crossed ? crossing(value[a], value[b]) : 0.5;
         for (int c = 0; c < 3; ++c) crossings[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
     }
     const auto point = [&](int code, double (&x)[3]) {
@@ -255,7 +259,7 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
     for (unsigned left = needed; left != 0; left &= left - 1) { // set bits: no branch per edge
         const int edge = std::countr_zero(left);
         const int a = kEdgeCorners[edge][0], b = kEdgeCorners[edge][1];
-        const double t = crossing(value[a], value[b], e.delta);
+        const double t = crossing(value[a], value[b]);
         for (int c = 0; c < 3; ++c)
             crossing_at[edge][c] = static_cast<double>(kCornerOffset[a][c]) + (c == edge / 4 ? t : 0.0);
     }
@@ -276,15 +280,11 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
             }
         }
     }
-    // the larger grid's index (MeshSpans::index_offset): base + p sums as its extract() does
-    const double base[3] = {static_cast<double>(i + e.offset[0]), static_cast<double>(j + e.offset[1]),
-                            static_cast<double>(k + e.offset[2])};
     for (int q = 0; q < tl.interior_count; ++q) {
         double p[3];
         detail::interior_position(detail::kInteriorMasks[tl.first_interior + q], crossing_at, p);
         const auto v = static_cast<std::size_t>(first + q - out.first_vertex);
-        const double x[3] = {base[0] + p[0], base[1] + p[1], base[2] + p[2]};
-        write_position(x, &out.positions[v * 3], out.zyx);
+        write_position(i, j, k, p, &out.positions[v * 3], out.zyx);
         double w[8];
         if (out.normals || out.vertex_values) detail::trilinear_weights(p, w);
         if (out.normals) {
@@ -293,10 +293,10 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
                 for (std::size_t a = 0; a < 3; ++a) n[a] += w[c] * grad[c][a];
             if (!write_normal(&out.normals[v * 3], n, out.zyx) &&
                 !write_normal(&out.normals[v * 3], cell_gradient(value, p, e.gradient_scale), out.zyx)) {
-                write_normal(&out.normals[v * 3], fan_gradient(value, tl, q, p, e.delta), out.zyx);
+                write_normal(&out.normals[v * 3], fan_gradient(value, tl, q, p), out.zyx);
             }
         }
-        if (out.vertex_edges) out.vertex_edges[v] = -1 - e.whole_cell(i, j, k);
+        if (out.vertex_edges) out.vertex_edges[v] = -1 - whole_cell(i, j, k);
         if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
         if (out.vertex_cell_ranges) out.vertex_cell_ranges[v] = static_cast<float>(cell_range(i, j, k));
         if (out.vertex_values) {

@@ -669,6 +669,28 @@ TEST(Passes, ABlockPlacedInTheWholeGridWritesTheWholesVerticesBitForBit)
     }
 }
 
+TEST(Passes, TheWholeGridPlacedInItselfWritesWhatItWritesUnplaced)
+{
+    // far from the origin (a margin wider than 2^-10), in a frame that is not diagonal
+    const Volume n = noise({17, 13, 15}, 9);
+    GridView<double> g = n.view<double>();
+    g.spacing = {0.75, 1.25, 2.0}, g.origin = {1500.0, -900.25, 2015.0};
+    g.direction = {{{0.6, -0.8, 0}, {0.8, 0.6, 0}, {0, 0, 1}}};
+    const Output unplaced = run_placed(g, 0.0, {0, 0, 0}, {0, 0, 0});
+    const Output placed = run_placed(g, 0.0, {0, 0, 0}, g.dims);
+    ASSERT_FALSE(unplaced.triangles.empty());
+    const auto bits = [](const std::vector<float>& v) {
+        std::vector<std::uint32_t> b(v.size());
+        std::transform(v.begin(), v.end(), b.begin(), [](float x) { return std::bit_cast<std::uint32_t>(x); });
+        return b;
+    };
+    EXPECT_EQ(bits(placed.positions), bits(unplaced.positions));
+    EXPECT_EQ(bits(placed.normals), bits(unplaced.normals));
+    EXPECT_EQ(placed.triangles, unplaced.triangles);
+    EXPECT_EQ(placed.edges, unplaced.edges);
+    EXPECT_EQ(placed.cells, unplaced.cells);
+}
+
 template <class F> std::optional<cmc33::Status> status_of(F&& f)
 {
     try {
