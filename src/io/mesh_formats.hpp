@@ -11,6 +11,7 @@
 #include <array>
 #include <bit>
 #include <charconv>
+#include <concepts>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -218,16 +219,29 @@ public:
     /// Shortest decimal that reads back as exactly `value` (std::to_chars).
     void real(float value);
     void real(double value); ///< shortest text that reads back as the same double
-    void integer(std::uint64_t value);
+    /// Decimal text of an integer of any width and sign, as printf's %lld or %llu writes it.
+    template <class T>
+        requires(std::integral<T> && !std::same_as<T, bool>)
+    void integer(T value)
+    {
+        if constexpr (std::is_signed_v<T>) {
+            signed_integer(static_cast<std::int64_t>(value));
+        } else {
+            unsigned_integer(static_cast<std::uint64_t>(value));
+        }
+    }
     void u8(std::uint8_t value) { character(static_cast<char>(value)); }
     void u16_le(std::uint16_t value) { put_le(value); }
     void u32_le(std::uint32_t value) { put_le(value); }
     void f32_le(float value) { put_le(std::bit_cast<std::uint32_t>(value)); }
     void f64_le(double value) { put_le(std::bit_cast<std::uint64_t>(value)); }
-    /// `count` records of `size` bytes (size <= 4096): fill(out, first, n) writes records first ..
-    /// first + n - 1 to out, as many at a time as the block has room for.
+    /// `count` records of `size` bytes: fill(out, first, n) writes records first .. first + n - 1
+    /// to out, as many at a time as the block has room for. A record larger than the block is
+    /// filled alone in memory of its own and written through (n = 1).
     template <class Fill> void records(std::size_t count, std::size_t size, Fill&& fill)
     {
+        if (size > kBlock) return large_records(count, size, fill);
+        if (size == 0) return; // nothing to write (and no division by zero below)
         for (std::size_t first = 0; first < count;) {
             if (kBlock - used_ < size) flush();
             const std::size_t n = std::min(count - first, (kBlock - used_) / size);
@@ -241,6 +255,16 @@ public:
 
 private:
     static constexpr std::size_t kBlock = std::size_t{1} << 18;
+    void unsigned_integer(std::uint64_t value);
+    void signed_integer(std::int64_t value);
+    template <class Fill> void large_records(std::size_t count, std::size_t size, Fill& fill)
+    {
+        const std::unique_ptr<char[]> record(new char[size]);
+        for (std::size_t r = 0; r < count; ++r) {
+            fill(record.get(), r, std::size_t{1});
+            bytes(record.get(), size); // at least a block: straight to the stream
+        }
+    }
     template <class U> void put_le(U value)
     {
         if (kBlock - used_ < sizeof(U)) flush();

@@ -225,9 +225,17 @@ void OutputBuffer::real(double value)
                                      data_.get());
 }
 
-void OutputBuffer::integer(std::uint64_t value)
+void OutputBuffer::unsigned_integer(std::uint64_t value)
 {
     constexpr std::size_t kMax = 24; // 2^64 has 20 digits
+    if (kBlock - used_ < kMax) flush();
+    used_ = static_cast<std::size_t>(std::to_chars(data_.get() + used_, data_.get() + used_ + kMax, value).ptr -
+                                     data_.get());
+}
+
+void OutputBuffer::signed_integer(std::int64_t value)
+{
+    constexpr std::size_t kMax = 24; // -2^63 has a sign and 19 digits
     if (kBlock - used_ < kMax) flush();
     used_ = static_cast<std::size_t>(std::to_chars(data_.get() + used_, data_.get() + used_ + kMax, value).ptr -
                                      data_.get());
