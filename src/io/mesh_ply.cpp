@@ -15,6 +15,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <unordered_set>
 #include <variant>
 #include <vector>
 
@@ -617,20 +618,13 @@ const char* integer_type(std::span<const std::int64_t> values, std::size_t& low,
     return nullptr;
 }
 
-// Text of a signed integer (OutputBuffer::integer takes unsigned values).
-void signed_integer(OutputBuffer& o, std::int64_t value)
-{
-    if (value >= 0) return o.integer(static_cast<std::uint64_t>(value));
-    o.character('-');
-    o.integer(static_cast<std::uint64_t>(-(value + 1)) + 1);
-}
-
 } // namespace
 
 std::vector<PlyFaceArray> ply_face_arrays(const std::vector<MeshArray>& arrays, const std::string& name)
 {
     std::vector<PlyFaceArray> faces;
-    std::vector<std::string> taken{"vertex_indices", "vertex_index"};
+    // a set: an array of many components brings as many names
+    std::unordered_set<std::string> taken{"vertex_indices", "vertex_index"};
     for (const MeshArray& a : arrays) {
         const auto fail = [&](const std::string& what) {
             throw Error(Status::invalid_argument,
@@ -639,10 +633,9 @@ std::vector<PlyFaceArray> ply_face_arrays(const std::vector<MeshArray>& arrays, 
         for (const std::string& property : property_names(a)) {
             const bool word = std::all_of(property.begin(), property.end(), [](char c) { return c > ' ' && c < 127; });
             if (!word) fail("a PLY property name is printable ASCII without blanks (the header splits its lines at blanks)");
-            if (std::find(taken.begin(), taken.end(), property) != taken.end()) {
+            if (!taken.insert(property).second) {
                 fail(concat("the face element already has a property ", quote_text(property), "; expected distinct names"));
             }
-            taken.push_back(property);
         }
         PlyFaceArray face{&a, "float"};
         if (std::holds_alternative<std::span<const std::int32_t>>(a.values)) face.type = "int";
@@ -729,9 +722,33 @@ void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* of
         }
     }
 
-    std::size_t values = 0; // face property values per triangle, 4 bytes each in binary
-    for (const PlyFaceArray& f : faces) values += static_cast<std::size_t>(f.array->components);
     if (ascii) {
+        // A line interleaves every array's values, so the loop over triangles is the outer one;
+        // each array's element type is looked up once here instead of per value.
+        struct Column {
+            const float* reals = nullptr;
+            const std::int32_t* narrow = nullptr;
+            const std::int64_t* wide = nullptr;
+            std::size_t components = 0;
+        };
+        std::vector<Column> columns;
+        for (const PlyFaceArray& a : faces) {
+            Column c;
+            c.components = static_cast<std::size_t>(a.array->components);
+            std::visit(
+                [&](const auto& span) {
+                    using T = typename std::decay_t<decltype(span)>::element_type;
+                    if constexpr (std::is_same_v<T, const float>) {
+                        c.reals = span.data();
+                    } else if constexpr (std::is_same_v<T, const std::int32_t>) {
+                        c.narrow = span.data();
+                    } else {
+                        c.wide = span.data();
+                    }
+                },
+                a.array->values);
+            columns.push_back(c);
+        }
         for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
             o.text("3 ");
             o.integer(t[3 * f]);
@@ -739,20 +756,17 @@ void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* of
             o.integer(t[3 * f + 1]);
             o.character(' ');
             o.integer(t[3 * f + 2]);
-            for (const PlyFaceArray& a : faces) {
-                const std::size_t c = static_cast<std::size_t>(a.array->components);
-                std::visit(
-                    [&](const auto& span) {
-                        for (std::size_t k = c * f; k < c * (f + 1); ++k) {
-                            o.character(' ');
-                            if constexpr (std::is_same_v<typename std::decay_t<decltype(span)>::element_type, const float>) {
-                                o.real(span[k]);
-                            } else {
-                                signed_integer(o, span[k]);
-                            }
-                        }
-                    },
-                    a.array->values);
+            for (const Column& c : columns) {
+                for (std::size_t k = c.components * f; k < c.components * (f + 1); ++k) {
+                    o.character(' ');
+                    if (c.reals) {
+                        o.real(c.reals[k]);
+                    } else if (c.narrow) {
+                        o.integer(c.narrow[k]);
+                    } else {
+                        o.integer(c.wide[k]);
+                    }
+                }
             }
             o.character('\n');
         }
@@ -760,38 +774,35 @@ void write_ply(const Mesh& mesh, std::ostream& out, bool ascii, const double* of
         return;
     }
     // Binary: uchar 3, 3 uints, then each array's values. int and uint values are the low 32 bits
-    // of the int64 ones: ply_face_arrays() chose a type that holds every value.
-    const std::size_t face_bytes = kPlyFaceBytes + 4 * values;
-    const auto fill = [&](char* dst, std::size_t f) {
-        dst[0] = 3;
-        store_u32s_le(dst + 1, t + 3 * f, 3);
-        dst += kPlyFaceBytes;
+    // of the int64 ones: ply_face_arrays() chose a type that holds every value. Each batch of
+    // records gets its indices first, then one array at a time (its type looked up once).
+    std::size_t face_bytes = kPlyFaceBytes;
+    for (const PlyFaceArray& f : faces) face_bytes += 4 * static_cast<std::size_t>(f.array->components);
+    o.records(mesh.triangle_count(), face_bytes, [&](char* dst, std::size_t first, std::size_t count) {
+        for (std::size_t f = first; f < first + count; ++f) {
+            char* record = dst + (f - first) * face_bytes;
+            record[0] = 3;
+            store_u32s_le(record + 1, t + 3 * f, 3);
+        }
+        std::size_t at = kPlyFaceBytes; // the array's first value within a record
         for (const PlyFaceArray& a : faces) {
             const std::size_t c = static_cast<std::size_t>(a.array->components);
             std::visit(
                 [&](const auto& span) {
-                    for (std::size_t k = c * f; k < c * (f + 1); ++k, dst += 4) {
-                        if constexpr (std::is_same_v<typename std::decay_t<decltype(span)>::element_type, const float>) {
-                            store_f32_le(dst, span[k]);
+                    using T = typename std::decay_t<decltype(span)>::element_type;
+                    for (std::size_t f = first; f < first + count; ++f) {
+                        char* values = dst + (f - first) * face_bytes + at;
+                        if constexpr (std::is_same_v<T, const float>) {
+                            store_f32s_le(values, span.data() + c * f, c);
                         } else {
-                            store_le(dst, static_cast<std::uint32_t>(span[k]));
+                            for (std::size_t k = 0; k < c; ++k) store_le(values + 4 * k, static_cast<std::uint32_t>(span[c * f + k]));
                         }
                     }
                 },
                 a.array->values);
+            at += 4 * c;
         }
-    };
-    if (face_bytes <= 4096) {
-        o.records(mesh.triangle_count(), face_bytes, [&](char* dst, std::size_t first, std::size_t count) {
-            for (std::size_t f = first; f < first + count; ++f, dst += face_bytes) fill(dst, f);
-        });
-    } else {
-        std::string record(face_bytes, '\0'); // more values per face than OutputBuffer::records takes
-        for (std::size_t f = 0; f < mesh.triangle_count(); ++f) {
-            fill(record.data(), f);
-            o.bytes(record.data(), face_bytes);
-        }
-    }
+    });
     o.flush();
 }
 

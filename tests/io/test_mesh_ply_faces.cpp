@@ -229,4 +229,90 @@ TEST(MeshPlyFaces, AnIndependentReaderFindsTheValues)
     }
 }
 
+/// Tetrahedron face records wider than 4,096 bytes: `components` floats and an int64 array of three
+/// components (negative values: PLY int), each value a function of its triangle and component.
+struct WideArrays {
+    std::vector<float> reals;
+    std::vector<std::int64_t> labels;
+    explicit WideArrays(std::size_t components) : reals(3 * components), labels(9)
+    {
+        for (std::size_t i = 0; i < reals.size(); ++i) reals[i] = static_cast<float>(i) * 0.25f - 1000.0f;
+        for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = static_cast<std::int64_t>(i * i) - 40;
+    }
+    io::MeshWriteOptions options(bool ascii) const
+    {
+        io::MeshWriteOptions o;
+        o.ascii = ascii;
+        o.triangle_arrays = {{"w", std::span<const float>(reals), static_cast<int>(reals.size() / 3)},
+                             {"l", std::span<const std::int64_t>(labels), 3}};
+        return o;
+    }
+};
+
+/// The binary file's face records hold exactly the arrays' values; cmc33's reader gives the mesh back.
+void expect_wide_records(const fs::path& path, const Mesh& m, const WideArrays& w)
+{
+    const std::size_t c = w.reals.size() / 3;
+    const std::string bytes = cmc33::test::read_file(path);
+    const std::size_t end = bytes.find("end_header\n");
+    ASSERT_NE(end, std::string::npos);
+    EXPECT_NE(bytes.find("property float w_" + std::to_string(c - 1) + "\nproperty int l_0\n"), std::string::npos);
+    const std::size_t data = end + 11;
+    const std::size_t face_bytes = 13 + 4 * c + 4 * 3;
+    ASSERT_EQ(bytes.size(), data + 4 * 12 + 3 * face_bytes);
+    for (std::size_t f = 0; f < 3; ++f) {
+        SCOPED_TRACE(f);
+        const std::size_t at = data + 4 * 12 + f * face_bytes;
+        EXPECT_EQ(bytes[at], 3);
+        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(u32_le(bytes, at + 1 + 4 * k), m.triangles[3 * f + k]);
+        std::size_t wrong = 0;
+        for (std::size_t k = 0; k < c; ++k) wrong += std::bit_cast<float>(u32_le(bytes, at + 13 + 4 * k)) != w.reals[c * f + k];
+        EXPECT_EQ(wrong, 0u);
+        for (std::size_t k = 0; k < 3; ++k)
+            EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 13 + 4 * c + 4 * k)), w.labels[3 * f + k]);
+    }
+    const Mesh back = io::read_mesh(path);
+    EXPECT_EQ(back.positions, m.positions);
+    EXPECT_EQ(back.triangles, m.triangles);
+}
+
+TEST(MeshPlyFaces, FaceRecordsLargerThan4096Bytes)
+{
+    // 1,100 floats and 3 ints per triangle: 4,425-byte records
+    const fs::path dir = cmc33::test::temp_dir();
+    const Mesh m = tetra();
+    const WideArrays w(1100);
+    io::write_mesh(m, dir / "w.ply", w.options(false));
+    expect_wide_records(dir / "w.ply", m, w);
+    // read independently (numpy from the header's layout; meshio too for ASCII), both encodings
+    for (const bool ascii : {false, true}) {
+        SCOPED_TRACE(ascii ? "ascii" : "binary");
+        const fs::path path = dir / (ascii ? "wa.ply" : "wb.ply");
+        io::write_mesh(m, path, w.options(ascii));
+        const json j = read_with_meshio(path);
+        if (j.is_null()) GTEST_SKIP() << "numpy is not installed (python3-numpy)";
+        const json& d = j["cell_data"];
+        ASSERT_EQ(d.size(), 1103u);
+        std::size_t wrong = 0;
+        for (std::size_t f = 0; f < 3; ++f) {
+            for (std::size_t k = 0; k < 1100; ++k)
+                wrong += d["w_" + std::to_string(k)][f].get<double>() != static_cast<double>(w.reals[1100 * f + k]);
+            for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(d["l_" + std::to_string(k)][f].get<std::int64_t>(), w.labels[3 * f + k]);
+        }
+        EXPECT_EQ(wrong, 0u);
+        EXPECT_EQ(j["dtypes"]["w_0"], "float32");
+        EXPECT_EQ(j["dtypes"]["l_0"], "int32");
+    }
+}
+
+TEST(MeshPlyFaces, FaceRecordsLargerThanTheOutputBlock)
+{
+    // 70,000 floats per triangle: records of 280,025 bytes, more than OutputBuffer's 256 KiB block
+    const fs::path dir = cmc33::test::temp_dir();
+    const Mesh m = tetra();
+    const WideArrays w(70000);
+    io::write_mesh(m, dir / "h.ply", w.options(false));
+    expect_wide_records(dir / "h.ply", m, w);
+}
+
 } // namespace
