@@ -282,7 +282,7 @@ private:
 
     /// The crossing parameter of the edge from sample value a to b, in [delta_, 1 - delta_]
     /// (src/core/placement.hpp: never on a sample, so ties do not collapse triangles).
-    double crossing(T a, T b) const;
+    CMC33_ALWAYS_INLINE double crossing(T a, T b) const;
 
     /// delta of placement.hpp for a grid of `dims` samples at `origin` with index-to-world map m:
     /// 2^-10 of an edge, or more where the output floats cannot tell a point delta along an edge

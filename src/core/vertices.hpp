@@ -22,7 +22,7 @@
 namespace cmc33::detail {
 
 template <class T>
-double RangeExtractor<T>::crossing(T a, T b) const
+CMC33_ALWAYS_INLINE double RangeExtractor<T>::crossing(T a, T b) const
 {
     const double va = static_cast<double>(a), vb = static_cast<double>(b);
     const double d = vb - va; // ends differ in sign: vb != va
