@@ -327,7 +327,11 @@ private:
             const bool proper = !repeated && !collinear(p[0], p[1], p[2]);
             if (own) {
                 if (!inside) ++out.strays;
-                if (!repeated && (p[0] == p[1] || p[1] == p[2] || p[0] == p[2])) ++out.coincident;
+                // distinct ids at one position, in a collapsed triangle too
+                for (int v = 0; v < 3; ++v) {
+                    const auto a = static_cast<std::size_t>(v), b = static_cast<std::size_t>((v + 1) % 3);
+                    if (c[a] != c[b] && p[a] == p[b]) ++out.coincident;
+                }
                 if (!proper) ++out.zero_area_triangles;
             }
             Placed e{cj * cells_x_ + ci, t, {}, proper};
@@ -375,13 +379,15 @@ private:
             if ((b.on[v] & need_b) == need_b) trace_b[nb++] = b_ids[v];
         }
         if (na == 0 || nb == 0) return; // the boxes meet only in the contact: disjoint
-        int common = 0;
-        for (int x = 0; x < na; ++x)
-            for (int y = 0; y < nb; ++y) common += trace_a[x] == trace_b[y] ? 1 : 0;
+        // corners of each trace whose id the other has (a collapsed triangle repeats an id)
+        int a_in_b = 0, b_in_a = 0;
+        for (int x = 0; x < na; ++x) a_in_b += std::find(trace_b, trace_b + nb, trace_a[x]) != trace_b + nb ? 1 : 0;
+        for (int y = 0; y < nb; ++y) b_in_a += std::find(trace_a, trace_a + na, trace_b[y]) != trace_a + na ? 1 : 0;
         // a trace within the other: the pair meets in the hull of what it shares. Distinct ids at
         // one position lie in the contact, hence in both traces: here both in one triangle, which
         // build() counts
-        if (common == na || common == nb) return;
+        if (a_in_b == na || b_in_a == nb) return;
+        const int common = a_in_b; // proper triangles below: no id repeated
         for (int x = 0; x < na; ++x)
             for (int y = 0; y < nb; ++y)
                 if (trace_a[x] != trace_b[y] && point(trace_a[x]) == point(trace_b[y])) ++out.coincident;

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cmc33/error.hpp"
@@ -185,57 +186,128 @@ TEST(ExtractedCheck, FindsTwoVerticesAtOnePosition)
     EXPECT_GT(mesh_geometry(e.mesh).coincident_vertices, 0);
 }
 
+/// The cell whose box holds triangle t's centroid (the grid's spacing is 1, its origin 0).
+std::array<int, 3> cell_of(const Mesh& m, std::size_t t)
+{
+    const std::uint32_t* c = &m.triangles[3 * t];
+    std::array<int, 3> cell{};
+    for (std::size_t k = 0; k < 3; ++k)
+        cell[k] = static_cast<int>(std::floor((m.positions[3 * c[0] + k] + m.positions[3 * c[1] + k] + m.positions[3 * c[2] + k]) / 3));
+    return cell;
+}
+
+/// `e`'s mesh with a copy of vertex u as vertex u + 1 (in u's plane; the ids after it move up by
+/// one, the triangles keep their vertices), and the grid that says so.
+struct WithCopy {
+    const Extracted& original;
+    Mesh mesh;
+    std::vector<std::int64_t> first_vertex;
+    ExtractedGrid grid() const
+    {
+        ExtractedGrid g = original.grid();
+        g.plane_first_vertex = first_vertex;
+        return g;
+    }
+};
+
+WithCopy with_copy_of(const Extracted& e, std::uint32_t u)
+{
+    const Mesh& m = e.mesh;
+    WithCopy c{e, m, e.stats.plane_first_vertex};
+    c.mesh.positions.clear();
+    c.mesh.normals.clear();
+    for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+        for (std::size_t k = 0; k < 3; ++k) c.mesh.positions.push_back(m.positions[3 * v + k]);
+        if (v == u)
+            for (std::size_t k = 0; k < 3; ++k) c.mesh.positions.push_back(m.positions[3 * v + k]);
+    }
+    for (std::uint32_t& v : c.mesh.triangles)
+        if (v > u) ++v;
+    for (auto& f : c.first_vertex)
+        if (f > static_cast<std::int64_t>(u)) ++f;
+    return c;
+}
+
 TEST(ExtractedCheck, FindsAVertexSplitBetweenNeighbouringCells)
 {
     // the triangles of one cell around an edge's vertex given a copy of it (a mesh not welded
     // there): the two ids meet only on the contact of neighbouring cells, where the structured
-    // check must see them (the grid's spacing is 1, its origin 0)
+    // check must see them
     const Extracted original = noise_mesh();
     const Mesh& m = original.mesh;
-    const auto cell_of = [&](std::size_t t) {
-        const std::uint32_t* c = &m.triangles[3 * t];
-        std::array<int, 3> cell{};
-        for (std::size_t k = 0; k < 3; ++k)
-            cell[k] = static_cast<int>(std::floor((m.positions[3 * c[0] + k] + m.positions[3 * c[1] + k] + m.positions[3 * c[2] + k]) / 3));
-        return cell;
-    };
     int split = 0;
     for (std::size_t t0 = 0; t0 < m.triangle_count() && split < 12; t0 += 97) {
         const std::uint32_t u = m.triangles[3 * t0];
-        const std::array<int, 3> cell = cell_of(t0);
-        // the copy is vertex u + 1, in u's plane: the ids after it move up by one
-        const std::uint32_t copy = u + 1;
-        Mesh broken = m;
-        broken.positions.clear();
-        for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
-            for (std::size_t k = 0; k < 3; ++k) broken.positions.push_back(m.positions[3 * v + k]);
-            if (v == u)
-                for (std::size_t k = 0; k < 3; ++k) broken.positions.push_back(m.positions[3 * v + k]);
-        }
-        broken.normals.clear();
+        const std::array<int, 3> cell = cell_of(m, t0);
+        WithCopy broken = with_copy_of(original, u);
         bool elsewhere = false; // u stays in a triangle of another cell
         for (std::size_t t = 0; t < m.triangle_count(); ++t)
             for (std::size_t q = 0; q < 3; ++q) {
-                const std::uint32_t v = m.triangles[3 * t + q];
-                broken.triangles[3 * t + q] = v > u ? v + 1 : v;
-                if (v != u) continue;
-                if (cell_of(t) == cell) {
-                    broken.triangles[3 * t + q] = copy;
+                if (m.triangles[3 * t + q] != u) continue;
+                if (cell_of(m, t) == cell) {
+                    broken.mesh.triangles[3 * t + q] = u + 1;
                 } else {
                     elsewhere = true;
                 }
             }
         if (!elsewhere) continue;
-        std::vector<std::int64_t> first_vertex = original.stats.plane_first_vertex;
-        for (auto& f : first_vertex)
-            if (f > static_cast<std::int64_t>(u)) ++f;
-        ExtractedGrid grid = original.grid();
-        grid.plane_first_vertex = first_vertex;
         SCOPED_TRACE("vertex " + std::to_string(u));
-        EXPECT_FALSE(expect_agrees(broken, grid)); // welding needs the general check
+        EXPECT_FALSE(expect_agrees(broken.mesh, broken.grid())); // welding needs the general check
         ++split;
     }
     EXPECT_EQ(split, 12);
+}
+
+TEST(ExtractedCheck, FindsCoincidentVerticesInCollapsedTriangles)
+{
+    // A triangle collapsed onto two ids (repeated corners). (a) (u', u', u) with u' a copy of u,
+    // in a cell where no other triangle uses u: the two ids at one position meet in that
+    // triangle only. (b) (u, u, w') with w' a copy of w, where a neighbouring cell's triangle
+    // has the edge u w on the contact: that triangle's trace holds u twice, which is not the
+    // other's trace {u, w}.
+    const Extracted original = noise_mesh();
+    const Mesh& m = original.mesh;
+    const std::size_t n = m.triangle_count();
+    std::vector<std::vector<std::size_t>> uses(m.vertex_count());
+    for (std::size_t t = 0; t < n; ++t)
+        for (std::size_t q = 0; q < 3; ++q) uses[m.triangles[3 * t + q]].push_back(t);
+    const auto used_in_cell = [&](std::uint32_t v, const std::array<int, 3>& cell) {
+        int count = 0;
+        for (std::size_t t : uses[v]) count += cell_of(m, t) == cell ? 1 : 0;
+        return count;
+    };
+    int lone = 0, traced = 0;
+    for (std::size_t t = 0; t < n && (lone < 6 || traced < 6); ++t) {
+        const std::array<int, 3> cell = cell_of(m, t);
+        for (std::size_t q = 0; q < 3; ++q) {
+            const std::uint32_t u = m.triangles[3 * t + q];
+            if (lone < 6 && used_in_cell(u, cell) == 1 && uses[u].size() > 1) {
+                WithCopy broken = with_copy_of(original, u);
+                broken.mesh.triangles[3 * t] = broken.mesh.triangles[3 * t + 1] = u + 1;
+                broken.mesh.triangles[3 * t + 2] = u;
+                SCOPED_TRACE("(a) triangle " + std::to_string(t));
+                EXPECT_FALSE(expect_agrees(broken.mesh, broken.grid()));
+                ++lone;
+            }
+            const std::uint32_t w = m.triangles[3 * t + (q + 1) % 3];
+            if (traced >= 6 || used_in_cell(w, cell) != 1) continue;
+            // a triangle of another cell with the edge u w
+            bool shared = false;
+            for (std::size_t s : uses[u])
+                if (s != t && cell_of(m, s) != cell)
+                    for (std::size_t r = 0; r < 3; ++r) shared |= m.triangles[3 * s + r] == w;
+            if (!shared) continue;
+            WithCopy broken = with_copy_of(original, w);
+            const std::uint32_t uu = u > w ? u + 1 : u;
+            broken.mesh.triangles[3 * t] = broken.mesh.triangles[3 * t + 1] = uu;
+            broken.mesh.triangles[3 * t + 2] = w + 1;
+            SCOPED_TRACE("(b) triangle " + std::to_string(t));
+            EXPECT_FALSE(expect_agrees(broken.mesh, broken.grid()));
+            ++traced;
+        }
+    }
+    EXPECT_EQ(lone, 6);
+    EXPECT_EQ(traced, 6);
 }
 
 TEST(ExtractedCheck, AMeshThatDoesNotFitTheLayoutGetsTheGeneralChecks)
