@@ -10,6 +10,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <type_traits>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -17,6 +18,7 @@
 #include "cmc33/cell.hpp"
 #include "cmc33/error.hpp"
 #include "parallel.hpp"
+#include "sample_types.hpp"
 
 namespace cmc33 {
 
@@ -674,21 +676,24 @@ LabelRanges parse_label_ranges(std::string_view text)
     return ranges;
 }
 
+template <class T> LabelSurfaces label_surfaces(const GridView<T>& labels, const LabelOptions& options)
+{
+    if constexpr (std::is_floating_point_v<T>) {
+        throw Error(Status::unsupported_format, "label maps need integer samples (int8 to uint32), got " +
+                                                    std::string(type_name(scalar_type_of<T>())));
+    } else {
+        return run(labels, options);
+    }
+}
+
 LabelSurfaces label_surfaces(const Volume& labels, const LabelOptions& options)
 {
-    if (labels.type() == ScalarType::f32 || labels.type() == ScalarType::f64) {
-        throw Error(Status::unsupported_format,
-                    "label maps need integer samples (int8 to uint32), got " + std::string(type_name(labels.type())));
-    }
-    return labels.visit([&](const auto& view) -> LabelSurfaces {
-        using T = std::remove_cvref_t<decltype(*view.data)>;
-        if constexpr (std::is_floating_point_v<T>) {
-            return {};
-        } else {
-            return run(view, options);
-        }
-    });
+    return labels.visit([&](const auto& view) { return label_surfaces(view, options); });
 }
+
+#define CMC33_INSTANTIATE(T) template LabelSurfaces label_surfaces<T>(const GridView<T>&, const LabelOptions&);
+CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
+#undef CMC33_INSTANTIATE
 
 Mesh label_surface(const LabelSurfaces& surfaces, std::int64_t label)
 {

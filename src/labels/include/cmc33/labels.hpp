@@ -67,6 +67,11 @@ struct LabelSurfaces {
 /// @throws Error{unsupported_format} for float or double samples; Error{too_large} past 2^32 vertices.
 CMC33_LABELS_EXPORT LabelSurfaces label_surfaces(const Volume& labels, const LabelOptions& options = {});
 
+/// The same over samples read in place (a numpy array with any strides, a sub-block of a larger
+/// grid): the frame is the view's.
+template <class T>
+CMC33_LABELS_EXPORT LabelSurfaces label_surfaces(const GridView<T>& labels, const LabelOptions& options = {});
+
 /// The closed surface of `label` (closed except where it meets the volume's box): the interface
 /// triangles with `label` on a side, wound so that normals point out of the label's region,
 /// with only the vertices they use. Empty for a label that is not in `selected`. When `interfaces`
