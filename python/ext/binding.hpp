@@ -25,6 +25,13 @@ namespace cmc33::python {
 
 namespace py = pybind11;
 
+/// cmc33.Mesh (bound in module.cpp): a cmc33::Mesh whose arrays numpy reads in place.
+struct PyMesh {
+    Mesh mesh;
+    std::optional<ExtractStats> stats; ///< cells per subcase, for meshes extract() made
+    bool normals = false;              ///< the mesh has normals (an empty mesh too, if asked for)
+};
+
 /// A 3D numpy array as the library reads it, in place: sample (i, j, k) is array[k, j, i], so x is
 /// the array's last axis (C order is the library's dense layout). Strides are in samples, any
 /// sign. `array` keeps the samples alive.

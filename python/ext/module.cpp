@@ -66,13 +66,6 @@ void translate_errors(std::exception_ptr p)
 // ------------------------------------------------------------------------------------------------
 // Meshes
 
-/// cmc33.Mesh: a cmc33::Mesh whose arrays numpy reads in place.
-struct PyMesh {
-    Mesh mesh;
-    std::optional<ExtractStats> stats; ///< cells per subcase, for meshes extract() made
-    bool normals = false;              ///< the mesh has normals (an empty mesh too, if asked for)
-};
-
 py::array rows_of(const py::object& owner, const py::dtype& dtype, const void* data, std::size_t rows, ssize columns)
 {
     const ssize size = dtype.itemsize();
@@ -625,6 +618,7 @@ VerifyReport verify_py(const std::vector<std::string>& methods, std::int64_t cel
 } // namespace
 
 void bind_blocks(py::module_& m); // blocks.cpp: cmc33.dask's per-block extraction
+void bind_labels(py::module_& m); // labels.cpp: label maps
 
 } // namespace cmc33::python
 
@@ -641,6 +635,7 @@ PYBIND11_MODULE(_cmc33, m)
     bind_topology(m);
     bind_verify(m);
     bind_blocks(m);
+    bind_labels(m);
 
     m.attr("version") = std::string(CMC33_VERSION_STRING);
     m.def("method_names", [] {

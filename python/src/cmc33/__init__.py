@@ -10,7 +10,8 @@ Two ways in:
 
 Beside them: :func:`read_volume`, :func:`write_volume`, :func:`read_mesh`, :func:`write_mesh`,
 :func:`mesh_topology`, :func:`field_topology` (the topology the mesh must have),
-:func:`mesh_geometry` (embedding checks with exact predicates), :func:`analyze_cell` and
+:func:`mesh_geometry` (embedding checks with exact predicates), :func:`label_surfaces` (every
+structure of a segmentation, sharing their interfaces), :func:`analyze_cell` and
 :func:`verify` (the stress test). Errors are subclasses of :class:`Error` and of the built-in
 exception one expects (ValueError, OSError, MemoryError).
 
@@ -27,11 +28,12 @@ from ._cmc33 import (CellReport, FaceReport, FieldTopology, InteriorReport, Mesh
                      MethodReport, VerifyReport, Volume, subcase_names)
 from ._api import (METHODS, analyze_cell, extract, field_topology, mesh_geometry, mesh_topology, random_field,
                    read_mesh, read_volume, verify, write_mesh, write_volume)
+from ._labels import LabelSurfaces, label_surfaces
 from ._skimage import marching_cubes
 from ._cmc33 import version as __version__
 
 __all__ = [
-    "marching_cubes", "extract", "read_volume", "write_volume", "read_mesh", "write_mesh", "mesh_topology",
+    "marching_cubes", "extract", "label_surfaces", "LabelSurfaces", "read_volume", "write_volume", "read_mesh", "write_mesh", "mesh_topology",
     "mesh_geometry", "field_topology", "analyze_cell", "random_field", "verify", "subcase_names", "METHODS",
     "Mesh", "Volume", "MeshTopology", "MeshGeometry", "FieldTopology", "CellReport", "FaceReport",
     "InteriorReport", "MethodReport", "VerifyReport",
