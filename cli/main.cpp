@@ -16,9 +16,11 @@
 #include <CLI/CLI.hpp>
 
 #include "cmc33/error.hpp"
+#include "cmc33/mesh.hpp"
 #include "cmc33/version.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "portability.hpp"
 
 namespace {
 
@@ -108,6 +110,8 @@ DashFile dash_file(CLI::App& app, const std::vector<std::string>& args)
 int main(int argc, char** argv)
 {
     cmc33::cli::install_signal_cleanup(); // first: every thread started later inherits its signal mask
+    // a new huge page costs more than it saves where the VM's balloon takes free memory back
+    cmc33::set_huge_page_advice(!cmc33::detail::balloon_reports_free_memory());
     CLI::App app("cmc33 " CMC33_VERSION_STRING ": extracts a topologically correct, manifold isosurface mesh\n"
                  "from a 3D scalar volume with Marching Cubes 33 (Custodio et al. 2013), and inspects\n"
                  "volumes, meshes and single cells.",

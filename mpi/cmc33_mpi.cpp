@@ -41,10 +41,12 @@
 
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
+#include "cmc33/mesh.hpp"
 #include "cmc33/version.hpp"
 #include "common.hpp"
 #include "extract_report.hpp"
 #include "plane_reader.hpp"
+#include "portability.hpp"
 #include "slabs.hpp"
 
 namespace cmc33::mpi {
@@ -498,6 +500,7 @@ int main(int argc, char** argv)
 {
     using namespace cmc33::mpi;
     cmc33::cli::install_signal_cleanup(); // before MPI starts its threads: they inherit the mask
+    cmc33::set_huge_page_advice(!cmc33::detail::balloon_reports_free_memory()); // as cmc33's main
     int provided = 0;
     MPI_Init_thread(&argc, &argv, MPI_THREAD_FUNNELED, &provided); // only the main thread calls MPI
     World w;

@@ -23,6 +23,7 @@
 
 #include "binding.hpp"
 #include "drop_in.hpp"
+#include "portability.hpp"
 
 #include "cmc33/cell.hpp"
 #include "cmc33/cmc33.hpp"
@@ -629,6 +630,8 @@ PYBIND11_MODULE(_cmc33, m)
     m.doc() = "The compiled part of the cmc33 package; use the functions of `cmc33` itself.";
     py::module_::import("numpy");
     py::register_exception_translator(&translate_errors);
+    // a new huge page costs more than it saves where the VM's balloon takes free memory back
+    set_huge_page_advice(!detail::balloon_reports_free_memory());
 
     bind_meshes(m);
     bind_volumes(m);

@@ -11,8 +11,9 @@
 // them all first, so that memory is held only for a next mesh of about the same size and never
 // beside a mesh of another: the peak stays that of one mesh, and what stays mapped after a mesh
 // is freed is at most that mesh's arrays.
-// On a VM whose balloon reports free memory (advise_huge_blocks below) no block is advised for
-// huge pages: a new huge page there is the dearest memory to write first.
+// The advice is an option (set_huge_page_advice): on a VM whose balloon reports free memory a new
+// huge page is the dearest memory to write first, and the programs that know where they run turn
+// it off there.
 // Blocks from 64 KiB to 1 MiB are glibc's too, but above its mmap threshold it maps them afresh
 // for each allocation, a fault per page written: they are rounded up to a size class (the next
 // eighth of their power of two, so that meshes of nearly the same size share one) and up to
@@ -21,6 +22,7 @@
 // `ulimit -v`) is reported as such, and the command line names the file it came from.
 
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cstddef>
 #include <cstdlib>
@@ -127,16 +129,7 @@ std::size_t size_class(std::size_t bytes) noexcept
     return bytes > std::numeric_limits<std::size_t>::max() - (step - 1) ? 0 : (bytes + step - 1) / step * step;
 }
 
-/// Whether new blocks are advised for huge pages: not on a VM whose balloon hands free memory back
-/// to its host (balloon_reports_free_memory, read once). There a new huge page comes from the
-/// blocks handed back, and its first writes take a fault in the host per 4 KiB, several times
-/// what the same bytes cost in 4 KiB pages; later extractions reuse the kept blocks, so 4 KiB
-/// pages cost them little (docs/performance.md, "Memory").
-bool advise_huge_blocks() noexcept
-{
-    static const bool advise = !balloon_reports_free_memory();
-    return advise;
-}
+std::atomic<bool> advise_huge_blocks{true}; // set_huge_page_advice
 
 /// A new block of `whole` bytes (whole huge pages, as allocated for a request of `bytes`),
 /// 2 MiB aligned, and advised for huge pages where advise_huge_blocks().
@@ -145,7 +138,7 @@ void* huge_page_block(std::size_t whole, std::size_t bytes)
     if (whole == 0) out_of_memory(bytes);
     void* p = aligned_allocate(kHugePageBytes, whole);
     if (p == nullptr) out_of_memory(bytes);
-    if (advise_huge_blocks()) advise_huge_pages(p, whole);
+    if (advise_huge_blocks.load(std::memory_order_relaxed)) advise_huge_pages(p, whole);
     return p;
 }
 } // namespace
@@ -198,3 +191,17 @@ void release_kept_buffers() noexcept
 }
 
 } // namespace cmc33::detail
+
+namespace cmc33 {
+
+void set_huge_page_advice(bool advise) noexcept
+{
+    detail::advise_huge_blocks.store(advise, std::memory_order_relaxed);
+}
+
+bool huge_page_advice() noexcept
+{
+    return detail::advise_huge_blocks.load(std::memory_order_relaxed);
+}
+
+} // namespace cmc33

@@ -153,11 +153,12 @@ TEST(Buffer, ABalloonThatReportsFreeMemoryIsFoundInSysfs)
     EXPECT_TRUE(balloon_reports_free_memory_in(root.string() + "/"));
 }
 
-TEST(Buffer, BlocksTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
+TEST(Buffer, BlocksTakeHugePagesAsAdvised)
 {
-    // src/base/buffer.cpp: blocks of 1 MiB and more are advised for huge pages, except where the
-    // balloon hands free memory back to the host. Seen in /proc/self/smaps (THPeligible) when the
-    // kernel's THP mode is "madvise", where the advice decides.
+    // src/base/buffer.cpp: blocks of 1 MiB and more are advised for huge pages unless
+    // set_huge_page_advice(false) (the CLI's choice where the balloon hands free memory back to
+    // the host). Seen in /proc/self/smaps (THPeligible) when the kernel's THP mode is "madvise",
+    // where the advice decides.
     std::string mode;
     std::getline(std::ifstream("/sys/kernel/mm/transparent_hugepage/enabled"), mode);
     if (mode.find("[madvise]") == std::string::npos) GTEST_SKIP() << "THP mode is not madvise: " << mode;
@@ -177,11 +178,15 @@ TEST(Buffer, BlocksTakeNoHugePagesWhereTheBalloonReportsFreeMemory)
         return false;
     };
     constexpr std::size_t kMiB = std::size_t{1} << 20;
-    const bool advised = !cmc33::detail::balloon_reports_free_memory();
-    for (const std::size_t bytes : {3 * kMiB, 28 * kMiB, 36 * kMiB}) { // up to 16 MiB, past it, past 32 MiB
-        void* block = cmc33::detail::allocate_buffer(bytes);
-        EXPECT_EQ(eligible(block), advised) << bytes << " bytes";
-        cmc33::detail::deallocate_buffer(block, bytes);
+    EXPECT_TRUE(cmc33::huge_page_advice()); // the library's default
+    for (const bool advised : {false, true}) {
+        cmc33::set_huge_page_advice(advised);
+        cmc33::detail::release_kept_buffers(); // new blocks, not ones kept under the other advice
+        for (const std::size_t bytes : {3 * kMiB, 28 * kMiB, 36 * kMiB}) { // up to 16 MiB, past it, past 32 MiB
+            void* block = cmc33::detail::allocate_buffer(bytes);
+            EXPECT_EQ(eligible(block), advised) << bytes << " bytes";
+            cmc33::detail::deallocate_buffer(block, bytes);
+        }
     }
 }
 

@@ -28,6 +28,14 @@ CMC33_BASE_EXPORT void deallocate_buffer(void* p, std::size_t bytes) noexcept;
 CMC33_BASE_EXPORT void release_kept_buffers() noexcept;
 } // namespace detail
 
+/// Whether Buffer's blocks of 1 MiB and more are advised for transparent huge pages (Linux; on by
+/// default): filling a large mesh then takes hundreds of times fewer page faults. On a VM whose
+/// memory balloon reports free memory to its host a new huge page costs more than it saves
+/// (docs/performance.md, "Memory"); the command line and the Python module turn the advice off
+/// there. Applies to blocks allocated after the call; thread-safe.
+CMC33_BASE_EXPORT void set_huge_page_advice(bool advise) noexcept;
+CMC33_BASE_EXPORT bool huge_page_advice() noexcept;
+
 /// std::allocator, except that resize(n) leaves new elements default-initialised (for float and
 /// integers: not written) instead of zeroing them. The extractor sizes a mesh once and writes every
 /// element in parallel; zeroing it first would be a second, single-threaded pass over the output.
