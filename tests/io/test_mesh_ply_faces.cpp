@@ -250,6 +250,17 @@ struct WideArrays {
 };
 
 /// The binary file's face records hold exactly the arrays' values; cmc33's reader gives the mesh back.
+void expect_wide_records(const fs::path& path, const Mesh& m, const WideArrays& w);
+
+/// tetra() with `w`'s arrays written in binary to dir/name and its records checked; the mesh.
+Mesh write_wide(const fs::path& dir, const char* name, const WideArrays& w)
+{
+    const Mesh m = tetra();
+    io::write_mesh(m, dir / name, w.options(false));
+    expect_wide_records(dir / name, m, w);
+    return m;
+}
+
 void expect_wide_records(const fs::path& path, const Mesh& m, const WideArrays& w)
 {
     const std::size_t c = w.reals.size() / 3;
@@ -280,10 +291,8 @@ TEST(MeshPlyFaces, FaceRecordsLargerThan4096Bytes)
 {
     // 1,100 floats and 3 ints per triangle: 4,425-byte records
     const fs::path dir = cmc33::test::temp_dir();
-    const Mesh m = tetra();
     const WideArrays w(1100);
-    io::write_mesh(m, dir / "w.ply", w.options(false));
-    expect_wide_records(dir / "w.ply", m, w);
+    const Mesh m = write_wide(dir, "w.ply", w);
     // read independently (numpy from the header's layout; meshio too for ASCII), both encodings
     for (const bool ascii : {false, true}) {
         SCOPED_TRACE(ascii ? "ascii" : "binary");
@@ -308,11 +317,7 @@ TEST(MeshPlyFaces, FaceRecordsLargerThan4096Bytes)
 TEST(MeshPlyFaces, FaceRecordsLargerThanTheOutputBlock)
 {
     // 70,000 floats per triangle: records of 280,025 bytes, more than OutputBuffer's 256 KiB block
-    const fs::path dir = cmc33::test::temp_dir();
-    const Mesh m = tetra();
-    const WideArrays w(70000);
-    io::write_mesh(m, dir / "h.ply", w.options(false));
-    expect_wide_records(dir / "h.ply", m, w);
+    write_wide(cmc33::test::temp_dir(), "h.ply", WideArrays(70000));
 }
 
 } // namespace

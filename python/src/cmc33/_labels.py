@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _cmc33
-from ._arrays import IDENTITY, mat3, thread_count, vec3
+from ._arrays import IDENTITY, as_samples, mat3, thread_count, vec3
 from ._cmc33 import Mesh, Volume
 
 #: "all", "1,3,7-9" (the command line's --labels), one label, or labels and (first, last) ranges.
@@ -74,28 +74,21 @@ def _ranges(labels: LabelSelection) -> List[Tuple[int, int]]:
 
 
 def _label_samples(labels: Any) -> np.ndarray:
-    """An integer array the library reads in place: int8 ... uint32 as given (any strides), bool as
-    uint8, int64 and uint64 (scikit-image's and scipy's label arrays) converted to the smallest of
-    int32 / uint32 that holds their values (a copy)."""
+    """An integer array the library reads in place (as_samples: int8 ... uint32 in any strides,
+    bool as uint8); int64 and uint64 (scikit-image's and scipy's label arrays) are first converted
+    to the smaller of int32 / uint32 that holds their values (a copy)."""
     array = np.asarray(labels)
-    if array.ndim != 3:
-        raise ValueError(f"labels have shape {array.shape}; expected a 3D array (nz, ny, nx)")
     dtype = array.dtype
-    if dtype == np.bool_:
-        return array.view(np.uint8)
-    if dtype.kind not in "iu":
+    if dtype != np.bool_ and dtype.kind not in "iu":
         raise ValueError(f"labels have type {dtype}; a label map needs integer samples")
-    if not dtype.isnative:
-        array = array.astype(dtype.newbyteorder("="))
-        dtype = array.dtype
-    if dtype.itemsize <= 4:
-        return array
-    low, high = (int(array.min()), int(array.max())) if array.size else (0, 0)
-    for target in (np.int32, np.uint32):
-        info = np.iinfo(target)
-        if info.min <= low and high <= info.max:
-            return array.astype(target)
-    raise ValueError(f"labels hold values from {low} to {high}; a label map's values must fit in int32 or uint32")
+    if dtype.itemsize == 8 and array.ndim == 3:
+        low, high = (int(array.min()), int(array.max())) if array.size else (0, 0)
+        fits = [t for t in (np.int32, np.uint32) if np.iinfo(t).min <= low and high <= np.iinfo(t).max]
+        if not fits:
+            raise ValueError(f"labels hold values from {low} to {high}; a label map's values must fit in int32 "
+                             "or uint32")
+        array = array.astype(fits[0])
+    return as_samples(array, "labels")
 
 
 def label_surfaces(labels: Union[Volume, Any], *, select: LabelSelection = "all", background: int = 0,
