@@ -140,6 +140,7 @@ void run_labels(const LabelsArgs& args)
                         {"interface_triangles", static_cast<std::int64_t>(s.interfaces.triangle_count())},
                         {"cells_two_labels", s.cells_two_labels},
                         {"cells_many_labels", s.cells_many_labels},
+                        {"cells_with_core", s.cells_with_core},
                         {"labels", labels}});
         return;
     }

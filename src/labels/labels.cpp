@@ -1,6 +1,7 @@
 // Label maps (labels.hpp, docs/labels.md): one pass over the cells; two-label cells take cmc33's
 // triangulation of the lower label's indicator at 0.5 from a table of its 256 corner patterns,
-// cells with three or more labels are cut by cones from their centre over their faces' curves.
+// cells with three or more labels are cut by cones from their centre over their faces' curves, or
+// around a core where such cones would pinch a label.
 
 #include "cmc33/labels.hpp"
 
@@ -15,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "cmc33/cell.hpp"
+#include "cells.hpp"
 #include "cmc33/error.hpp"
 #include "parallel.hpp"
 #include "sample_types.hpp"
@@ -24,65 +25,7 @@ namespace cmc33 {
 
 namespace {
 
-// A vertex of a cell's triangle: doubled coordinates in the cell (0..2 each: corners, edge
-// midpoints, face and cell centres), or an interior point of cmc33's triangulation.
-struct TableVertex {
-    std::array<int, 3> doubled{0, 0, 0};
-    bool interior = false;
-    int slot = 0;                        ///< interior points: which of the cell's (below kInteriorSlots)
-    std::array<double, 3> unit{0, 0, 0}; ///< position in the unit cube (interior points)
-};
-
-// cmc33's tunnels (7.4.1, 13.5.1 and the like) place up to 12 points inside a cell
-constexpr std::uint64_t kInteriorSlots = 16;
-
-struct Pattern {
-    std::vector<std::array<TableVertex, 3>> triangles;
-};
-
-// cmc33's triangles of the cell whose corners in `config` hold the lower label (value 1 at iso
-// 0.5: every crossing is an edge midpoint, every tied face saddle joins the lower label).
-std::array<Pattern, 256> make_patterns()
-{
-    std::array<Pattern, 256> patterns;
-    for (unsigned config = 1; config < 255; ++config) {
-        std::array<double, 8> values{};
-        for (unsigned c = 0; c < 8; ++c) values[c] = (config >> c & 1U) != 0 ? 1.0 : 0.0;
-        const CellReport report = analyze_cell(values, 0.5, Method::cmc33);
-        const Mesh& m = report.mesh;
-        std::vector<std::array<double, 3>> interior;
-        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-            std::array<TableVertex, 3> tri{};
-            for (std::size_t v = 0; v < 3; ++v) {
-                const std::size_t index = m.triangles[3 * t + v];
-                TableVertex& out = tri[v];
-                for (std::size_t a = 0; a < 3; ++a) {
-                    const double p = static_cast<double>(m.positions[3 * index + a]);
-                    out.unit[a] = p;
-                    const double twice = 2 * p;
-                    out.doubled[a] = static_cast<int>(twice);
-                    if (twice != static_cast<double>(out.doubled[a])) out.interior = true;
-                }
-                if (out.interior) {
-                    const auto it = std::find(interior.begin(), interior.end(), out.unit);
-                    out.slot = static_cast<int>(it - interior.begin());
-                    if (it == interior.end()) interior.push_back(out.unit);
-                    if (interior.size() > kInteriorSlots) {
-                        throw Error(Status::internal, "label maps: a cell pattern with more than 16 interior points");
-                    }
-                }
-            }
-            patterns[config].triangles.push_back(tri);
-        }
-    }
-    return patterns;
-}
-
-const std::array<Pattern, 256>& patterns()
-{
-    static const std::array<Pattern, 256> table = make_patterns();
-    return table;
-}
+using namespace label_cells;
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
@@ -134,77 +77,8 @@ struct Part {
     std::vector<std::int64_t> front, behind;
     std::vector<std::array<std::uint32_t, 2>> bottom, top; ///< (index in the plane, vertex id)
     std::unordered_set<std::int64_t> present;
-    std::int64_t cells_two_labels = 0, cells_many_labels = 0;
+    std::int64_t cells_two_labels = 0, cells_many_labels = 0, cells_with_core = 0;
 };
-
-using Doubled = std::array<int, 3>;
-
-Doubled corner_doubled(unsigned c)
-{
-    return {2 * static_cast<int>(c & 1U), static_cast<int>(c & 2U), static_cast<int>(c >> 1 & 2U)};
-}
-
-Doubled midpoint(unsigned u, unsigned w)
-{
-    const Doubled a = corner_doubled(u), b = corner_doubled(w);
-    return {(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, (a[2] + b[2]) / 2};
-}
-
-// A cell with three or more labels: a triangle from the centre to every segment of every face's
-// curve. A segment starts at the midpoint of a face edge (u, w) whose labels differ and ends at
-// `to`; u's label lies on u's side of it.
-template <class Emit> void many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
-{
-    const Doubled centre{1, 1, 1};
-    const auto segment = [&](unsigned u, unsigned w, const Doubled& to) {
-        const Doubled m = midpoint(u, w), cu = corner_doubled(u);
-        const Doubled p{m[0] - 1, m[1] - 1, m[2] - 1}, q{to[0] - 1, to[1] - 1, to[2] - 1};
-        const Doubled n{p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]};
-        const int side = n[0] * (cu[0] - 1) + n[1] * (cu[1] - 1) + n[2] * (cu[2] - 1);
-        // the triangle's plane meets the face along the segment's line, which misses the corner u
-        if (side > 0)
-            emit(centre, m, to, label[u], label[w]);
-        else
-            emit(centre, m, to, label[w], label[u]);
-    };
-    for (unsigned axis = 0; axis < 3; ++axis) {
-        const unsigned b = (axis + 1) % 3, c = (axis + 2) % 3;
-        for (unsigned s = 0; s < 2; ++s) {
-            // the face's corners in cyclic order
-            const std::array<unsigned, 4> q{s << axis, s << axis | 1U << b, s << axis | 1U << b | 1U << c,
-                                            s << axis | 1U << c};
-            std::array<std::int64_t, 4> l{label[q[0]], label[q[1]], label[q[2]], label[q[3]]};
-            std::array<std::int64_t, 4> sorted = l;
-            std::sort(sorted.begin(), sorted.end());
-            const auto distinct = std::unique(sorted.begin(), sorted.end()) - sorted.begin();
-            if (distinct == 1) continue;
-            // a label on both ends of a diagonal is joined across the face (the lower one when both
-            // diagonals are alike, cmc33's tie rule): the other corners are cut off
-            const bool diagonal0 = l[0] == l[2], diagonal1 = l[1] == l[3];
-            if (diagonal0 || diagonal1) {
-                const std::int64_t joined = diagonal0 && diagonal1 ? sorted[0] : (diagonal0 ? l[0] : l[1]);
-                for (unsigned i = 0; i < 4; ++i) {
-                    if (l[i] != joined) segment(q[i], q[(i + 1) % 4], midpoint(q[(i + 3) % 4], q[i]));
-                }
-                continue;
-            }
-            if (distinct == 2) {
-                std::array<unsigned, 2> crossed{};
-                unsigned found = 0;
-                for (unsigned i = 0; i < 4; ++i) {
-                    if (l[i] != l[(i + 1) % 4]) crossed[found++] = i;
-                }
-                segment(q[crossed[0]], q[(crossed[0] + 1) % 4], midpoint(q[crossed[1]], q[(crossed[1] + 1) % 4]));
-                continue;
-            }
-            Doubled face_centre{1, 1, 1};
-            face_centre[axis] = 2 * static_cast<int>(s);
-            for (unsigned i = 0; i < 4; ++i) {
-                if (l[i] != l[(i + 1) % 4]) segment(q[i], q[(i + 1) % 4], face_centre);
-            }
-        }
-    }
-}
 
 // Every label of a grid too thin to have cells.
 template <class T> std::vector<std::int64_t> scan_present(const GridView<T>& g)
@@ -320,10 +194,23 @@ private:
             return;
         }
         ++out_.cells_many_labels;
-        many_label_cell(
-            label, [&](const Doubled& a, const Doubled& b, const Doubled& c, std::int64_t front, std::int64_t behind) {
-                if (chosen_.wanted(front, behind)) add({at(a), at(b), at(c)}, front, behind);
+        std::array<std::uint32_t, 27> core;
+        core.fill(kNone);
+        const auto vertex = [&](const Quad& q) {
+            if (q[0] % 2 == 0 && q[1] % 2 == 0 && q[2] % 2 == 0) return at({q[0] / 2, q[1] / 2, q[2] / 2});
+            // a corner of the cell's core: the cell's own
+            std::uint32_t& id = core[static_cast<std::size_t>((q[0] - 1) + 3 * (q[1] - 1) + 9 * (q[2] - 1))];
+            if (id == kNone) {
+                id = new_vertex(static_cast<double>(i) + 0.25 * q[0], static_cast<double>(j) + 0.25 * q[1],
+                                static_cast<double>(k) + 0.25 * q[2]);
+            }
+            return id;
+        };
+        const bool took_core = many_label_cell(
+            label, [&](const Quad& a, const Quad& b, const Quad& c, std::int64_t front, std::int64_t behind) {
+                if (chosen_.wanted(front, behind)) add({vertex(a), vertex(b), vertex(c)}, front, behind);
             });
+        if (took_core) ++out_.cells_with_core;
     }
 
     // Room for the range at the rate of its layers so far (a quarter more), once that passes the
@@ -610,6 +497,7 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
             present.insert(p.present.begin(), p.present.end());
             out.cells_two_labels += p.cells_two_labels;
             out.cells_many_labels += p.cells_many_labels;
+            out.cells_with_core += p.cells_with_core;
         }
         out.present.assign(present.begin(), present.end());
         std::sort(out.present.begin(), out.present.end());
@@ -620,7 +508,7 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
     }
     if (out.selected.empty()) {
         // nothing selected: no cell was triangulated, none counted
-        out.cells_two_labels = out.cells_many_labels = 0;
+        out.cells_two_labels = out.cells_many_labels = out.cells_with_core = 0;
     }
     // with many labels, finding each one's triangles by a scan of all would cost labels x triangles
     if (out.selected.size() > 8 && out.front.size() < kNone) index_by_label(out);

@@ -63,16 +63,44 @@ TEST(Labels, TwoLabelFieldsAreTheIndicatorsLevelSet)
     }
 }
 
-// Three and four labels: closed, oriented, embedded and watertight; the non-manifold surfaces
-// (a label meeting itself at a cell centre, docs/labels.md) are counted, not failed.
+// Three and four labels: closed, manifold, oriented, embedded and watertight (cells where a
+// label's part of the surface is not one disk take a core, docs/labels.md).
 TEST(Labels, ThreeAndFourLabelFields)
 {
     for (const int labels : {3, 4})
-        for (const bool smooth : {false, true}) {
-            Counts c = sweep(labels, 75, smooth);
-            c.not_manifold = 0; // counted, not failed (see above)
-            expect_guarantees(c);
-        }
+        for (const bool smooth : {false, true}) expect_guarantees(sweep(labels, 75, smooth));
+}
+
+// One cell whose label 1 holds two opposite corners: its part of the cell's surface is two
+// pieces, so the cell is cut around a core that label 1 takes (one piece, not two cones pinched
+// at the centre); labels 2 and 3 each hold one piece. Label 1's corners are (0, 0, 0) and (1, 1, 1).
+TEST(Labels, ACoreJoinsALabelOfTwoPieces)
+{
+    Volume v(ScalarType::i32, {2, 2, 2});
+    const std::array<std::int32_t, 8> corners{1, 2, 2, 3, 2, 3, 3, 1}; // x fastest, then y, then z
+    std::copy(corners.begin(), corners.end(), v.samples<std::int32_t>());
+    Counts c;
+    label_checks::check_field(v, c, "two pieces of label 1");
+    expect_guarantees(c);
+    const LabelSurfaces s = label_surfaces(v);
+    EXPECT_EQ(s.cells_many_labels, 1);
+    EXPECT_EQ(s.cells_with_core, 1);
+    EXPECT_EQ(mesh_topology(label_surface(s, 1)).components, 1);
+    for (const std::int64_t l : {2, 3}) EXPECT_EQ(mesh_topology(label_surface(s, l)).components, 1) << l;
+}
+
+// A cell where every label is one disk on the cell's surface keeps the cone from the centre.
+TEST(Labels, NoCoreWhereEveryLabelIsOneDisk)
+{
+    Volume v(ScalarType::i32, {2, 2, 2});
+    const std::array<std::int32_t, 8> corners{1, 1, 2, 2, 1, 1, 3, 3};
+    std::copy(corners.begin(), corners.end(), v.samples<std::int32_t>());
+    Counts c;
+    label_checks::check_field(v, c, "three slabs");
+    expect_guarantees(c);
+    const LabelSurfaces s = label_surfaces(v);
+    EXPECT_EQ(s.cells_many_labels, 1);
+    EXPECT_EQ(s.cells_with_core, 0);
 }
 
 TEST(Labels, Deterministic)
@@ -102,6 +130,7 @@ void expect_same(const LabelSurfaces& a, const LabelSurfaces& b, const std::stri
     EXPECT_EQ(a.selected, b.selected) << what;
     EXPECT_EQ(a.cells_two_labels, b.cells_two_labels) << what;
     EXPECT_EQ(a.cells_many_labels, b.cells_many_labels) << what;
+    EXPECT_EQ(a.cells_with_core, b.cells_with_core) << what;
     ASSERT_EQ(a.interfaces.normals.size(), b.interfaces.normals.size()) << what;
     EXPECT_EQ(std::memcmp(a.interfaces.normals.data(), b.interfaces.normals.data(), a.interfaces.normals.size() * 4), 0)
         << what;

@@ -33,7 +33,7 @@ class LabelSurfaces:
     selected : tuple of int
         The labels that got surfaces, ascending.
     cells_two_labels, cells_many_labels : int
-        Cells holding two labels (cmc33's triangulation) and three or more (the centre construction).
+        Cells holding two labels (cmc33's triangulation) and three or more (cones from the centre, or a core).
     """
 
     interfaces: Mesh

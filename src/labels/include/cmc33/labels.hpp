@@ -6,7 +6,8 @@
 /// Labels are integers at the samples. A label's region is where its indicator's trilinear
 /// interpolant is largest, ties to the lower label. In a cell holding two labels a < b that is the
 /// level set 0.5 of a's indicator, triangulated with cmc33's own decisions (a's corners above); a
-/// cell holding three or more labels is cut by cones from its centre over its faces' curves.
+/// cell holding three or more labels is cut by cones from its centre over its faces' curves, or
+/// around a core where a cone would pinch a label's surface; every label's surface is a manifold.
 /// Each interface triangle is emitted once with the label in front (the side its normal points
 /// to) and the label behind; a label's closed surface is the triangles that have it on a side.
 
@@ -53,7 +54,8 @@ struct LabelSurfaces {
     std::vector<std::int64_t> present;       ///< every label value in the volume, ascending
     std::vector<std::int64_t> selected;      ///< the labels that get surfaces, ascending
     std::int64_t cells_two_labels = 0;       ///< cells with exactly two labels (cmc33's triangulation)
-    std::int64_t cells_many_labels = 0;      ///< cells with three or more (the centre construction)
+    std::int64_t cells_many_labels = 0;      ///< cells with three or more (cones or a core)
+    std::int64_t cells_with_core = 0;        ///< of those, the cells cut around a core (a label not one disk)
     /// label_surface()'s index when many labels are selected (empty otherwise): the triangles with
     /// selected[i] on a side are by_label[by_label_start[i] .. by_label_start[i + 1]), ascending.
     std::vector<std::uint32_t> by_label;
