@@ -1,8 +1,9 @@
 // label_surfaces() on segmentations made from the shared volumes by thresholds (tissue classes):
-// the checks of label_checks.cpp.
+// the checks of label_checks.cpp; and the aneurism's connected components, each a label.
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <vector>
 
@@ -33,13 +34,41 @@ Volume classes(const Volume& v, const std::vector<double>& thresholds)
     return out;
 }
 
-void check_volume(const std::string& file, const std::vector<double>& thresholds)
+// The connected components (through faces) of the samples at or above `iso`, numbered 1, 2, ... in
+// the order of their first sample; 0 elsewhere.
+Volume components(const Volume& v, double iso)
 {
-    const auto path = test::shared_volume(file);
-    if (!path) {
-        GTEST_SKIP() << file << " not found";
+    Volume out = classes(v, {iso}); // 1 at or above iso: a sample no component has reached yet
+    std::int32_t* s = out.samples<std::int32_t>();
+    const Index3 n = out.dims();
+    std::vector<std::int64_t> stack;
+    std::int32_t id = 1; // components take 2, 3, ... while 1 means "not reached"
+    for (std::int64_t start = 0; start < out.sample_count(); ++start) {
+        if (s[start] != 1) continue;
+        s[start] = ++id;
+        stack.push_back(start);
+        while (!stack.empty()) {
+            const std::int64_t at = stack.back();
+            stack.pop_back();
+            const Index3 p{at % n[0], at / n[0] % n[1], at / (n[0] * n[1])};
+            const Index3 step{1, n[0], n[0] * n[1]};
+            for (std::size_t axis = 0; axis < 3; ++axis) {
+                for (const std::int64_t d : {-1, 1}) {
+                    if (p[axis] + d < 0 || p[axis] + d >= n[axis]) continue;
+                    const std::int64_t to = at + d * step[axis];
+                    if (s[to] != 1) continue;
+                    s[to] = id;
+                    stack.push_back(to);
+                }
+            }
+        }
     }
-    const Volume seg = classes(io::read_volume(*path), thresholds);
+    for (std::int64_t i = 0; i < out.sample_count(); ++i) s[i] = s[i] == 0 ? 0 : s[i] - 1;
+    return out;
+}
+
+void check_segmentation(const std::string& file, const Volume& seg)
+{
     label_checks::Counts c;
     label_checks::check_field(seg, c, file);
     std::cout << file << ": " << c.label_surfaces << " label surfaces; not manifold " << c.not_manifold << " ("
@@ -54,6 +83,15 @@ void check_volume(const std::string& file, const std::vector<double>& thresholds
         << c.first_failure;
 }
 
+void check_volume(const std::string& file, const std::vector<double>& thresholds)
+{
+    const auto path = test::shared_volume(file);
+    if (!path) {
+        GTEST_SKIP() << file << " not found";
+    }
+    check_segmentation(file, classes(io::read_volume(*path), thresholds));
+}
+
 TEST(LabelsVolumes, ToothThreeClasses)
 {
     check_volume("tooth_103x94x161_uint8.nrrd", {100, 190});
@@ -65,6 +103,24 @@ TEST(LabelsVolumes, ToothTwoClasses)
 TEST(LabelsVolumes, CTheadThreeClasses)
 {
     check_volume("CThead_256x256x113_uint16.nrrd", {600, 1400});
+}
+TEST(LabelsVolumes, BonsaiThreeClasses)
+{
+    check_volume("bonsai_256x256x256_uint8.nrrd", {40.5, 150.5});
+}
+// the vessels' ~1,300 connected components at 80.5, each a label
+TEST(LabelsVolumes, AneurismComponents)
+{
+    const std::string file = "aneurism_256x256x256_uint8.nrrd";
+    const auto path = test::shared_volume(file);
+    if (!path) {
+        GTEST_SKIP() << file << " not found";
+    }
+    const Volume seg = components(io::read_volume(*path), 80.5);
+    std::int32_t most = 0;
+    for (std::int64_t i = 0; i < seg.sample_count(); ++i) most = std::max(most, seg.samples<std::int32_t>()[i]);
+    EXPECT_GT(most, 1000);
+    check_segmentation(file + " components", seg);
 }
 
 } // namespace
