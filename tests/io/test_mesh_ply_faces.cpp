@@ -17,6 +17,7 @@
 #include <iostream>
 #include <limits>
 #include <span>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,81 @@ const std::string kFaceHeader = "element face 3\nproperty list uchar uint vertex
                                 "property int region\nproperty uint label\nproperty int pair_0\nproperty int pair_1\n"
                                 "end_header\n";
 
+/// The bytes of one value of the PLY scalar type `type`, or 0 for a name PLY does not have.
+std::size_t ply_type_bytes(const std::string& type)
+{
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+        return 4;
+    if (type == "double" || type == "float64") return 8;
+    return 0;
+}
+
+/// The face records of `m` written as the binary little-endian PLY file `bytes`, read by the layout
+/// its header declares (the vertex records skipped by their properties' sizes, then per face a
+/// `list uchar uint vertex_indices` and 4-byte scalar properties): per triangle, the words of its
+/// properties after vertex_indices, in the header's order. A failure is added, and no records
+/// returned, when the header is not of that shape, the faces do not have `words` properties each,
+/// they are not m's triangles in order, or the records do not end exactly at the end of the file.
+std::vector<std::vector<std::uint32_t>> face_records(const std::string& bytes, const Mesh& m, std::size_t words)
+{
+    const std::size_t end = bytes.find("end_header\n");
+    if (end == std::string::npos) {
+        ADD_FAILURE() << "no end_header";
+        return {};
+    }
+    EXPECT_NE(bytes.find("\nformat binary_little_endian 1.0\n"), std::string::npos);
+    std::istringstream header(bytes.substr(0, end));
+    std::string line;
+    std::string element;
+    std::size_t vertices = 0;
+    std::size_t vertex_bytes = 0;
+    std::size_t faces = 0;
+    std::size_t face_words = 0;
+    while (std::getline(header, line)) {
+        std::istringstream fields(line);
+        std::string key;
+        std::string type;
+        fields >> key;
+        if (key == "element") {
+            std::size_t n = 0;
+            fields >> element >> n;
+            (element == "vertex" ? vertices : faces) = n;
+        }
+        if (key != "property") continue;
+        fields >> type;
+        if (element == "vertex") {
+            EXPECT_NE(ply_type_bytes(type), 0u) << line;
+            vertex_bytes += ply_type_bytes(type);
+        } else if (type == "list") {
+            EXPECT_EQ(line, "property list uchar uint vertex_indices");
+        } else {
+            EXPECT_EQ(ply_type_bytes(type), 4u) << line;
+            ++face_words;
+        }
+    }
+    EXPECT_EQ(face_words, words) << "face properties after vertex_indices";
+    EXPECT_EQ(faces, m.triangles.size() / 3) << "faces";
+    std::vector<std::vector<std::uint32_t>> records;
+    cmc33::Buffer<std::uint32_t> indices;
+    std::size_t at = end + 11 + vertices * vertex_bytes;
+    for (std::size_t f = 0; f < faces && at < bytes.size(); ++f) {
+        const std::size_t n = static_cast<unsigned char>(bytes[at]);
+        if (at + 1 + 4 * (n + face_words) > bytes.size()) break;
+        for (std::size_t k = 0; k < n; ++k) indices.push_back(u32_le(bytes, at + 1 + 4 * k));
+        records.emplace_back();
+        for (std::size_t k = 0; k < face_words; ++k) records.back().push_back(u32_le(bytes, at + 1 + 4 * (n + k)));
+        at += 1 + 4 * (n + face_words);
+    }
+    EXPECT_EQ(records.size(), faces) << "the file ends inside the face records";
+    EXPECT_EQ(at, bytes.size()) << "the face records do not end where the file ends";
+    EXPECT_EQ(indices, m.triangles) << "the faces' vertex_indices";
+    const bool whole =
+        face_words == words && records.size() == m.triangles.size() / 3 && at == bytes.size() && indices == m.triangles;
+    return whole ? records : std::vector<std::vector<std::uint32_t>>{};
+}
+
 TEST(MeshPlyFaces, BinaryRecordsHoldTheValues)
 {
     const fs::path dir = cmc33::test::temp_dir();
@@ -71,20 +147,17 @@ TEST(MeshPlyFaces, BinaryRecordsHoldTheValues)
     const std::string bytes = cmc33::test::read_file(dir / "b.ply");
     const std::size_t end = bytes.find("end_header\n");
     ASSERT_NE(end, std::string::npos);
-    const std::size_t data = end + 11;
-    EXPECT_NE(bytes.substr(0, data).find(kFaceHeader), std::string::npos) << bytes.substr(0, data);
-    const std::size_t face_bytes = 13 + 4 * 5;
-    ASSERT_EQ(bytes.size(), data + 4 * 12 + 3 * face_bytes);
+    EXPECT_NE(bytes.substr(0, end + 11).find(kFaceHeader), std::string::npos) << bytes.substr(0, end + 11);
+    const std::vector<std::vector<std::uint32_t>> faces = face_records(bytes, m, 5);
+    ASSERT_EQ(faces.size(), 3u);
     for (std::size_t f = 0; f < 3; ++f) {
         SCOPED_TRACE(f);
-        const std::size_t at = data + 4 * 12 + f * face_bytes;
-        EXPECT_EQ(bytes[at], 3);
-        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(u32_le(bytes, at + 1 + 4 * k), m.triangles[3 * f + k]);
-        EXPECT_EQ(std::bit_cast<float>(u32_le(bytes, at + 13)), kQuality[f]);
-        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 17)), kRegion[f]);
-        EXPECT_EQ(u32_le(bytes, at + 21), static_cast<std::uint64_t>(kLabel[f]));
-        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 25)), kPair[2 * f]);
-        EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 29)), kPair[2 * f + 1]);
+        const std::vector<std::uint32_t>& w = faces[f];
+        EXPECT_EQ(std::bit_cast<float>(w[0]), kQuality[f]);
+        EXPECT_EQ(static_cast<std::int32_t>(w[1]), kRegion[f]);
+        EXPECT_EQ(w[2], static_cast<std::uint64_t>(kLabel[f]));
+        EXPECT_EQ(static_cast<std::int32_t>(w[3]), kPair[2 * f]);
+        EXPECT_EQ(static_cast<std::int32_t>(w[4]), kPair[2 * f + 1]);
     }
     // cmc33's reader skips the properties by their declared types: the same mesh
     const Mesh back = io::read_mesh(dir / "b.ply");
@@ -265,22 +338,16 @@ void expect_wide_records(const fs::path& path, const Mesh& m, const WideArrays& 
 {
     const std::size_t c = w.reals.size() / 3;
     const std::string bytes = cmc33::test::read_file(path);
-    const std::size_t end = bytes.find("end_header\n");
-    ASSERT_NE(end, std::string::npos);
     EXPECT_NE(bytes.find("property float w_" + std::to_string(c - 1) + "\nproperty int l_0\n"), std::string::npos);
-    const std::size_t data = end + 11;
-    const std::size_t face_bytes = 13 + 4 * c + 4 * 3;
-    ASSERT_EQ(bytes.size(), data + 4 * 12 + 3 * face_bytes);
+    const std::vector<std::vector<std::uint32_t>> faces = face_records(bytes, m, c + 3);
+    ASSERT_EQ(faces.size(), 3u);
     for (std::size_t f = 0; f < 3; ++f) {
         SCOPED_TRACE(f);
-        const std::size_t at = data + 4 * 12 + f * face_bytes;
-        EXPECT_EQ(bytes[at], 3);
-        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(u32_le(bytes, at + 1 + 4 * k), m.triangles[3 * f + k]);
+        const std::vector<std::uint32_t>& words = faces[f];
         std::size_t wrong = 0;
-        for (std::size_t k = 0; k < c; ++k) wrong += std::bit_cast<float>(u32_le(bytes, at + 13 + 4 * k)) != w.reals[c * f + k];
+        for (std::size_t k = 0; k < c; ++k) wrong += std::bit_cast<float>(words[k]) != w.reals[c * f + k];
         EXPECT_EQ(wrong, 0u);
-        for (std::size_t k = 0; k < 3; ++k)
-            EXPECT_EQ(static_cast<std::int32_t>(u32_le(bytes, at + 13 + 4 * c + 4 * k)), w.labels[3 * f + k]);
+        for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(static_cast<std::int32_t>(words[c + k]), w.labels[3 * f + k]);
     }
     const Mesh back = io::read_mesh(path);
     EXPECT_EQ(back.positions, m.positions);
