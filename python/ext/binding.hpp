@@ -12,9 +12,11 @@
 #include <cstdint>
 #include <exception>
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <thread>
+#include <type_traits>
 #include <utility>
 
 #include "cmc33/error.hpp"
@@ -155,6 +157,25 @@ template <class R> R run_interruptible(bool background, const py::object& progre
     if (declined) throw Error(Status::cancelled, "cancelled: the progress callback returned False");
     if (!progress.is_none()) progress(1.0);
     return std::move(*result);
+}
+
+/// `values` (a std::vector, moved here) as a numpy array that owns it, without a copy: a capsule
+/// deletes the vector with the array. `columns` > 0 gives a 2D array of that many columns (the
+/// size a multiple of it), 0 a 1D array.
+template <class V> py::array_t<typename V::value_type> to_numpy(V&& values, std::int64_t columns = 0)
+{
+    static_assert(!std::is_reference_v<V>, "to_numpy takes the vector by std::move");
+    using E = typename V::value_type;
+    auto owned = std::make_unique<V>(std::move(values));
+    V& v = *owned;
+    const py::capsule free_when_done(owned.get(), [](void* o) { delete static_cast<V*>(o); });
+    owned.release();
+    const auto size = static_cast<py::ssize_t>(v.size());
+    if (columns > 0) {
+        const auto c = static_cast<py::ssize_t>(columns);
+        return py::array_t<E>({size / c, c}, v.data(), free_when_done);
+    }
+    return py::array_t<E>({size}, v.data(), free_when_done);
 }
 
 /// Smallest and largest sample, NaN skipped (NaN, NaN if every sample is NaN); without the GIL,

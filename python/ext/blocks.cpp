@@ -149,18 +149,6 @@ template <class T> BlockResult extract_block(GridView<T> grid, const BlockArgs& 
     return r;
 }
 
-template <class V> py::array_t<typename V::value_type> to_numpy(V&& values, I64 columns)
-{
-    using E = typename V::value_type;
-    auto* owned = new V(std::move(values));
-    py::capsule free_when_done(owned, [](void* o) { delete static_cast<V*>(o); });
-    const auto rows = columns > 0 ? static_cast<py::ssize_t>(owned->size()) / columns : static_cast<py::ssize_t>(owned->size());
-    if (columns > 0) {
-        return py::array_t<E>({rows, static_cast<py::ssize_t>(columns)}, owned->data(), free_when_done);
-    }
-    return py::array_t<E>({rows}, owned->data(), free_when_done);
-}
-
 } // namespace
 
 void bind_blocks(py::module_& m)

@@ -7,7 +7,6 @@
 #include <pybind11/stl.h>
 
 #include <cstdint>
-#include <cstring>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,13 +23,6 @@ struct Labelled {
     LabelSurfaces surfaces;
     std::vector<Mesh> per_label; // one per surfaces.selected, when asked for
 };
-
-template <class T> py::array_t<T> copy_of(const std::vector<T>& values)
-{
-    py::array_t<T> out(static_cast<py::ssize_t>(values.size()));
-    if (!values.empty()) std::memcpy(out.mutable_data(), values.data(), values.size() * sizeof(T));
-    return out;
-}
 
 py::tuple label_surfaces_py(const py::array& labels, const Vec3& spacing, const Vec3& origin, const Mat3& direction,
                             std::int64_t background, const LabelRanges& selection, bool normals, int threads,
@@ -57,7 +49,7 @@ py::tuple label_surfaces_py(const py::array& labels, const Vec3& spacing, const 
         surfaces[py::int_(out.surfaces.selected[i])] = py::cast(PyMesh{std::move(out.per_label[i]), std::nullopt, normals});
     }
     LabelSurfaces& r = out.surfaces;
-    py::object front = copy_of(r.front), behind = copy_of(r.behind);
+    py::object front = to_numpy(std::move(r.front)), behind = to_numpy(std::move(r.behind));
     py::object interfaces = py::cast(PyMesh{std::move(r.interfaces), std::nullopt, normals});
     return py::make_tuple(interfaces, front, behind, per_label ? py::object(surfaces) : py::object(py::none()),
                           r.present, r.selected, r.cells_two_labels, r.cells_many_labels);
