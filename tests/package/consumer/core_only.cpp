@@ -29,6 +29,7 @@ int main()
     const bool same = mesh.triangle_count() == triangles &&
                       std::equal(indices.begin(), indices.end(), mesh.triangles.begin()) &&
                       std::equal(positions.begin(), positions.end(), mesh.positions.begin());
-    std::printf("cmc33::core alone: %zu triangles, %s extract()\n", triangles, same ? "the same as" : "NOT the same as");
+    std::printf("cmc33::core alone (%s): %zu triangles, %s extract()\n", CMC33_CONSUMED, triangles,
+                same ? "the same as" : "NOT the same as");
     return same ? 0 : 1;
 }
