@@ -3,10 +3,12 @@
 // Quadrics: Garland and Heckbert 1997, "Surface Simplification Using Quadric Error Metrics": each
 // input triangle's plane adds its squared-distance form to its three corners; a boundary edge adds
 // the plane through it perpendicular to its triangle, so boundaries keep their shape. A collapse
-// of edge ab puts the kept vertex at the minimum of Qa + Qb on the segment ab (clamped to it):
-// the unconstrained 3D optimum is ill-conditioned on the flat and cylindrical patches a marching
-// cubes mesh is made of and can land far from both stars, where the embedding check refuses it;
-// on the segment the vertex stays within the two stars' region and the cost is still minimal there.
+// of edge ab puts the kept vertex at the cheaper of two points: the minimum of Qa + Qb on the
+// segment ab, and its minimum nearest ab's midpoint with the directions of small curvature left
+// out (minimum_near). The plain 3D optimum is ill-conditioned on the flat and cylindrical patches
+// a marching cubes mesh is made of and can land far from both stars, where the embedding check
+// refuses it; the second point moves only along well-determined directions, so it finds corners
+// and creases the segment misses (a quarter lower mean distance to the input on bonsai).
 //
 // Topology: the link condition (Dey, Edelsbrunner, Guha and Nekhayev 1999) with the boundary coned
 // off by a virtual vertex: for interior edge ab with opposite corners c and d, the common
@@ -55,6 +57,66 @@ struct Quadric {
                2 * q[6] * y + q[7] * z * z + 2 * q[8] * z + q[9];
     }
 };
+
+double cost_at(const Quadric& q, const Pos& p)
+{
+    return q.eval(static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2]));
+}
+
+/// The minimum of q nearest the midpoint of the edge x .. x + e: the normal equations solved with
+/// the eigenvalues below 1e-3 of the largest left out (Lindstrom 2000, "Out-of-core simplification
+/// of large polygonal models"), so that along flat and cylindrical directions the point stays at
+/// the midpoint. False when it lands farther from the midpoint than the edge is long.
+bool minimum_near(const Quadric& quadric, const double x[3], const double e[3], Pos& out)
+{
+    const auto& s = quadric.q;
+    double a[3][3] = {{s[0], s[1], s[2]}, {s[1], s[4], s[5]}, {s[2], s[5], s[7]}};
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}; // eigenvectors, by column
+    for (int sweep = 0; sweep < 12; ++sweep) {         // cyclic Jacobi rotations
+        const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        const double diagonal = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if (off <= 1e-30 * diagonal) break;
+        for (int p = 0; p < 2; ++p)
+            for (int r = p + 1; r < 3; ++r) {
+                if (a[p][r] == 0) continue;
+                const double theta = (a[r][r] - a[p][p]) / (2 * a[p][r]);
+                const double t = (theta >= 0 ? 1 : -1) / (std::abs(theta) + std::sqrt(theta * theta + 1));
+                const double cs = 1 / std::sqrt(t * t + 1), sn = t * cs;
+                for (int k = 0; k < 3; ++k) {
+                    const double kp = a[k][p], kr = a[k][r];
+                    a[k][p] = cs * kp - sn * kr;
+                    a[k][r] = sn * kp + cs * kr;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double pk = a[p][k], rk = a[r][k];
+                    a[p][k] = cs * pk - sn * rk;
+                    a[r][k] = sn * pk + cs * rk;
+                }
+                for (int k = 0; k < 3; ++k) {
+                    const double kp = v[k][p], kr = v[k][r];
+                    v[k][p] = cs * kp - sn * kr;
+                    v[k][r] = sn * kp + cs * kr;
+                }
+            }
+    }
+    const double largest = std::max({std::abs(a[0][0]), std::abs(a[1][1]), std::abs(a[2][2])});
+    if (!(largest > 0)) return false;
+    const double m[3] = {x[0] + 0.5 * e[0], x[1] + 0.5 * e[1], x[2] + 0.5 * e[2]};
+    // half the gradient at the midpoint: A m + b
+    const double g[3] = {s[0] * m[0] + s[1] * m[1] + s[2] * m[2] + s[3], s[1] * m[0] + s[4] * m[1] + s[5] * m[2] + s[6],
+                         s[2] * m[0] + s[5] * m[1] + s[7] * m[2] + s[8]};
+    double step[3] = {0, 0, 0};
+    for (int i = 0; i < 3; ++i) {
+        const double lambda = a[i][i];
+        if (lambda < 1e-3 * largest) continue;
+        const double along = -(v[0][i] * g[0] + v[1][i] * g[1] + v[2][i] * g[2]) / lambda;
+        for (int k = 0; k < 3; ++k) step[k] += along * v[k][i];
+    }
+    const double moved = step[0] * step[0] + step[1] * step[1] + step[2] * step[2];
+    if (!(moved <= e[0] * e[0] + e[1] * e[1] + e[2] * e[2])) return false;
+    for (int k = 0; k < 3; ++k) out[static_cast<std::size_t>(k)] = static_cast<float>(m[k] + step[k]);
+    return true;
+}
 
 struct Candidate {
     double cost;
@@ -157,8 +219,10 @@ struct Simplifier {
             double t = 0.5;
             if (quad > 1e-12 * (std::abs(lin) + 1e-300)) t = std::clamp(-lin / quad, 0.0, 1.0);
             for (int k = 0; k < 3; ++k) c.p[static_cast<std::size_t>(k)] = static_cast<float>(x[k] + t * e[k]);
+            Pos free;
+            if (minimum_near(q, x, e, free) && cost_at(q, free) < cost_at(q, c.p)) c.p = free;
         }
-        c.cost = std::max(0.0, q.eval(static_cast<double>(c.p[0]), static_cast<double>(c.p[1]), static_cast<double>(c.p[2])));
+        c.cost = std::max(0.0, cost_at(q, c.p));
         return c;
     }
 
