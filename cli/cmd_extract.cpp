@@ -6,12 +6,12 @@
 #include <memory>
 #include <optional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
+#include "cmc33/threads.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/topology.hpp"
 #include "commands.hpp"
@@ -127,7 +127,7 @@ void run_extract(const ExtractArgs& args)
     report.triangles = static_cast<std::int64_t>(mesh.triangle_count());
     report.seconds = seconds;
     report.runs_seconds = runs;
-    report.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    report.threads = cmc33::thread_count(args.threads);
     report.topology = topology;
     report.geometry = geometry;
     report.stats = stats;

@@ -9,11 +9,11 @@
 #include <memory>
 #include <span>
 #include <string>
-#include <thread>
 
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
+#include "cmc33/threads.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "extract_report.hpp"
@@ -146,7 +146,7 @@ void run_extract_slabs(const ExtractArgs& args)
     report.triangles = totals.triangles;
     report.seconds = seconds;
     report.runs_seconds = {seconds};
-    report.threads = args.threads > 0 ? args.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    report.threads = cmc33::thread_count(args.threads);
     report.stats = totals.stats;
     if (!args.no_topology) {
         report.topology = result.topology.finish();

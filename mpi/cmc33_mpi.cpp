@@ -42,6 +42,7 @@
 #include "atomic_file.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/mesh.hpp"
+#include "cmc33/threads.hpp"
 #include "cmc33/version.hpp"
 #include "common.hpp"
 #include "extract_report.hpp"
@@ -413,7 +414,7 @@ void run_extract(const World& w, const ExtractArgs& args)
     report.triangles = totals[1];
     report.seconds = total;
     report.runs_seconds = {total};
-    report.threads = args.threads; // per rank (0: all cores of the node)
+    report.threads = cmc33::thread_count(args.threads); // per rank
     for (std::size_t s = 0; s < subcases.size(); ++s) report.stats.cells_per_subcase[s] = subcases[s];
     if (!args.no_topology) {
         report.topology = topology.finish();

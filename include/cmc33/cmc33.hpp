@@ -11,6 +11,7 @@
 #include "cmc33/mesh_ops.hpp"
 #include "cmc33/passes.hpp"
 #include "cmc33/sweep.hpp"
+#include "cmc33/threads.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
 #include "cmc33/version.hpp"

@@ -1,6 +1,7 @@
 // numpy arrays read in place, and their value range.
 
 #include "binding.hpp"
+#include "parallel.hpp"
 
 #include <algorithm>
 #include <array>
@@ -9,7 +10,6 @@
 #include <cstdlib>
 #include <limits>
 #include <string>
-#include <thread>
 #include <vector>
 
 namespace cmc33::python {
@@ -72,12 +72,11 @@ template <class T> std::pair<double, double> range_of(const Samples& s, int thre
     constexpr T kHigh = kFloat ? std::numeric_limits<T>::infinity() : std::numeric_limits<T>::max();
 
     // threads only pay off on large volumes (a thread costs about what 10^5 samples do)
-    const int wanted = s.count() < (std::int64_t{1} << 20) ? 1 : resolve_threads(threads);
-    const int n = static_cast<int>(std::clamp<std::int64_t>(wanted, 1, n2));
+    const int n = s.count() < (std::int64_t{1} << 20) ? 1 : detail::threads_for(threads, n2);
     std::vector<std::pair<T, T>> found(static_cast<std::size_t>(n), {kHigh, kLow});
-    const auto part = [&](int t) {
+    detail::parallel_chunks(n2, n, [&](int t, std::int64_t c0, std::int64_t c1) {
         T lo = kHigh, hi = kLow;
-        for (std::int64_t c = n2 * t / n; c < n2 * (t + 1) / n && !control.stopped(); ++c)
+        for (std::int64_t c = c0; c < c1 && !control.stopped(); ++c)
             for (std::int64_t b = 0; b < n1; ++b) {
                 const T* row = base + c * s2 + b * s1;
                 if (s0 == 1) { // comparisons are false for NaN: it is skipped
@@ -94,11 +93,7 @@ template <class T> std::pair<double, double> range_of(const Samples& s, int thre
                 }
             }
         found[static_cast<std::size_t>(t)] = {lo, hi};
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < n; ++t) pool.emplace_back(part, t);
-    part(0);
-    for (std::thread& th : pool) th.join();
+    });
     if (control.stopped()) throw Error(Status::cancelled, "value range cancelled");
     T lo = kHigh, hi = kLow;
     for (const auto& [l, h] : found) {
@@ -160,12 +155,6 @@ std::pair<double, double> value_range(const Samples& samples, int threads)
             return dispatch_scalar_type(samples.type,
                                         [&](auto tag) { return range_of<decltype(tag)>(samples, threads, control); });
         });
-}
-
-int resolve_threads(int threads) noexcept
-{
-    if (threads > 0) return threads;
-    return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
 } // namespace cmc33::python

@@ -182,7 +182,4 @@ template <class V> py::array_t<typename V::value_type> to_numpy(V&& values, std:
 /// interruptible as run_interruptible is. @throws Error{invalid_argument} for an empty array
 std::pair<double, double> value_range(const Samples& samples, int threads);
 
-/// Number of worker threads for `threads` (0: every core the machine has).
-int resolve_threads(int threads) noexcept;
-
 } // namespace cmc33::python

@@ -9,14 +9,11 @@
 #include "drop_in.hpp"
 
 #include <algorithm>
-#include <atomic>
-#include <exception>
 #include <functional>
 #include <limits>
 #include <numeric>
 #include <span>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -25,50 +22,18 @@
 namespace cmc33::python {
 namespace {
 
-// Ranges of about 16 sample planes with threads, 64 with one: the stop flag is read between
-// ranges, so a range of 512^2 planes ends a Ctrl-C wait in tens of milliseconds, while the planes
-// a range reads twice (its ends) and its setup stay a small share (which is why one thread takes
-// 64). With threads, at least 4 ranges per thread, as extract() does, so that uneven surfaces
-// still end the threads together.
-constexpr std::int64_t kPlanesPerRange = 16;
-constexpr std::int64_t kPlanesPerRangeAlone = 64;
-constexpr std::int64_t kMinRanges = 32;
+// A stop request (Ctrl-C) is answered between ranges of sample planes, once the ranges running
+// end: plan_ranges cuts them to at most this many samples (64 planes of 512^2), so that the wait
+// stays short however few threads there are.
+constexpr std::int64_t kStopSamples = std::int64_t{64} << 18;
 constexpr std::uint32_t kDropped = std::numeric_limits<std::uint32_t>::max();
 
-/// Runs job(r, t) for every range r of `order` (a permutation of 0 .. ranges - 1) on n threads
-/// t = 0 .. n - 1 (0 the calling one), each taking the next range of `order` when it is free. No
-/// range starts once control says stop or a job has thrown; then the error of the lowest range
-/// that threw is rethrown, or Error{cancelled}. Reports the fraction
-/// from + share * (ranges done / ranges) to control.
-void run_ranges(int n, std::span<const int> order, Control& control, double from, double share,
-                const std::function<void(int range, int thread)>& job)
+/// run_ranges() (passes.hpp) reporting from + share * (fraction of the ranges done) to control,
+/// and stopping once control says so.
+void run_controlled(int threads, std::span<const int> order, Control& control, double from, double share,
+                    const std::function<void(int range, int thread)>& job)
 {
-    const int ranges = static_cast<int>(order.size());
-    std::atomic<int> next{0}, done{0};
-    std::atomic<bool> failed{false};
-    std::vector<std::exception_ptr> errors(order.size());
-    const auto work = [&](int thread) {
-        for (int taken = next.fetch_add(1); taken < ranges; taken = next.fetch_add(1)) {
-            const int r = order[static_cast<std::size_t>(taken)];
-            if (failed.load(std::memory_order_relaxed) || control.stopped()) return;
-            try {
-                job(r, thread);
-            } catch (...) {
-                errors[static_cast<std::size_t>(r)] = std::current_exception();
-                failed.store(true, std::memory_order_relaxed);
-            }
-            control.keep_going(from + share * (done.fetch_add(1) + 1) / ranges);
-        }
-    };
-    {
-        std::vector<std::jthread> pool;
-        for (int t = 1; t < n; ++t) pool.emplace_back(work, t);
-        work(0);
-    }
-    for (const std::exception_ptr& e : errors) {
-        if (e) std::rethrow_exception(e);
-    }
-    if (control.stopped()) throw Error(Status::cancelled, "extraction cancelled by the progress callback");
+    cmc33::run_ranges(threads, order, job, [&](double done) { return control.keep_going(from + share * done); });
 }
 
 template <class T> class DropIn {
@@ -81,34 +46,26 @@ public:
 
     DropInMesh run(Control& control)
     {
-        const std::int64_t nz = g_.nz();
-        const int n = static_cast<int>(std::clamp<std::int64_t>(resolve_threads(o_.threads), 1, nz));
-        std::int64_t ranges = std::min(nz, std::clamp<std::int64_t>(nz / (n == 1 ? kPlanesPerRangeAlone : kPlanesPerRange), n,
-                                                                  std::max<std::int64_t>(4 * n, kMinRanges)));
+        const RangePlan plan = plan_ranges(g_, o_.threads, kStopSamples);
+        const int n = plan.threads;
+        const auto plane = [&plan](int r) { return plan.first_planes[static_cast<std::size_t>(r)]; };
         // where x is not the contiguous axis (Fortran order), each range is read through a
         // window() of about 4 MiB (passes.hpp), one buffer per thread
-        const std::int64_t window_planes = window_range_planes(g_);
-        if (window_planes > 0) ranges = std::max(ranges, (nz + window_planes - 1) / window_planes);
-        const auto plane = [&](std::int64_t r) { return nz * r / ranges; };
-        std::vector<Buffer<T>> windows(static_cast<std::size_t>(window_planes > 0 ? n : 0));
-        const auto grid_of = [&](std::int64_t r, int thread) {
-            if (window_planes == 0) return g_;
+        std::vector<Buffer<T>> windows(static_cast<std::size_t>(plan.window_planes > 0 ? n : 0));
+        const auto grid_of = [&](int r, int thread) {
+            if (plan.window_planes == 0) return g_;
             return window(g_, plane(r), plane(r + 1), windows[static_cast<std::size_t>(thread)]);
         };
 
-        std::vector<int> order(static_cast<std::size_t>(ranges));
+        std::vector<int> order(static_cast<std::size_t>(plan.ranges()));
         std::iota(order.begin(), order.end(), 0);
-        std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
-        run_ranges(n, order, control, 0, 0.5, [&](int r, int thread) {
+        std::vector<RangeCounts> counts(order.size());
+        run_controlled(n, order, control, 0, 0.5, [&](int r, int thread) {
             counts[static_cast<std::size_t>(r)] = count(grid_of(r, thread), iso_, options_, plane(r), plane(r + 1));
         });
-        const std::vector<RangeOffsets> offsets = scan(counts);
-        const std::int64_t nv = offsets.back().first_vertex + counts.back().vertex_count();
-        const std::int64_t nt = offsets.back().first_triangle + counts.back().triangle_count();
-        if (nv >= static_cast<std::int64_t>(kDropped)) {
-            throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
-                                               " vertices, more than 32-bit indices can address");
-        }
+        const MeshLayout layout = lay_out(counts);
+        const std::vector<RangeOffsets>& offsets = layout.offsets;
+        const std::int64_t nv = layout.vertex_count, nt = layout.triangle_count;
         DropInMesh m;
         m.positions.resize(static_cast<std::size_t>(nv) * 3);
         m.normals.resize(static_cast<std::size_t>(nv) * 3);
@@ -116,11 +73,11 @@ public:
         m.triangles.resize(static_cast<std::size_t>(nt) * 3);
         m.vertex_count = nv;
         m.triangle_count = nt;
-        std::vector<std::vector<SeamValue>> seams(static_cast<std::size_t>(ranges));
+        std::vector<std::vector<SeamValue>> seams(counts.size());
         // with a mask, per thread, the cells of its range's triangles, reused from range to range
         // (fresh memory for every range would cost a page fault per 4 KiB of it)
         std::vector<Buffer<std::int64_t>> cells(static_cast<std::size_t>(o_.mask ? n : 0));
-        run_ranges(n, emit_order(counts), control, 0.5, 0.5, [&](int r, int thread) {
+        run_controlled(n, emit_order(counts), control, 0.5, 0.5, [&](int r, int thread) {
             const auto i = static_cast<std::size_t>(r);
             const GridView<T> g = grid_of(r, thread);
             if (o_.mask) {

@@ -18,14 +18,6 @@
 namespace cmc33::detail {
 
 template <class T>
-void RangeExtractor<T>::share_largest_sample(std::vector<RangeCounts>& counts)
-{
-    double largest = 0;
-    for (const RangeCounts& c : counts) largest = std::max(largest, c.largest_sample_);
-    for (RangeCounts& c : counts) c.largest_sample_ = largest;
-}
-
-template <class T>
 bool RangeExtractor<T>::same_rows(const RangeCounts& c, const GridView<T>& g)
 {
     const std::int64_t planes = std::min(c.k1_, g.nz() - 1) - c.k0_ + 1;
@@ -177,7 +169,6 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::count_row(std::int64_t j, std::int64
 
 #define CMC33_INSTANTIATE(T) \
     template RangeCounts RangeExtractor<T>::count(std::int64_t, std::int64_t, double, Ticker*) const; \
-    template void RangeExtractor<T>::share_largest_sample(std::vector<RangeCounts>&); \
     template bool RangeExtractor<T>::same_rows(const RangeCounts&, const GridView<T>&);
 CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <limits>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -19,7 +18,6 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/passes.hpp"
 #include "grid_checks.hpp"
-#include "parallel.hpp"
 #include "range_extractor.hpp"
 #include "refine.hpp"
 #include "sample_types.hpp"
@@ -59,29 +57,24 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
     detail::check_grid(grid, iso);
     const std::int64_t nz = grid.nz();
     const detail::RangeExtractor<T> extractor(grid, iso, options);
-    const int n = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, nz));
-    // More ranges than threads, taken in turn by whichever thread is free: a surface is seldom
-    // spread evenly over the planes. Ranges of at least 8 planes keep the planes read twice (at
-    // the ranges' ends) few; the mesh is the same for every split. Where x is not the contiguous
-    // axis, each range is read through a window() (passes.hpp) of about 4 MiB (at least 3 planes).
-    const std::int64_t window_planes = window_range_planes(grid);
-    std::int64_t split = n == 1 ? 1 : std::clamp<std::int64_t>(nz / 8, n, 8 * std::int64_t{n});
-    if (window_planes > 0) split = std::max(split, (nz + window_planes - 1) / window_planes);
-    const int ranges = static_cast<int>(std::min<std::int64_t>(split, std::numeric_limits<int>::max()));
-    const auto first_plane = [nz, ranges](int r) { return nz * r / ranges; };
+    // The ranges (plan_ranges): more than threads, taken in turn by whichever thread is free;
+    // where x is not the contiguous axis, each read through a window() (passes.hpp)
+    const RangePlan plan = plan_ranges(grid, options.threads);
+    const int n = plan.threads;
+    const auto first_plane = [&plan](int r) { return plan.first_planes[static_cast<std::size_t>(r)]; };
     // runs work on the extractor of range r: `extractor`, or one on the range's window in task t's
     // buffer (an extractor's tables take microseconds, a window's copy milliseconds)
-    std::vector<Buffer<T>> windows(static_cast<std::size_t>(window_planes > 0 ? n : 0));
+    std::vector<Buffer<T>> windows(static_cast<std::size_t>(plan.window_planes > 0 ? n : 0));
     const auto with_extractor = [&](int r, int t, const auto& work) {
-        if (window_planes == 0) return work(extractor);
+        if (plan.window_planes == 0) return work(extractor);
         const GridView<T> view = window(grid, first_plane(r), first_plane(r + 1), windows[static_cast<std::size_t>(t)]);
         return work(detail::RangeExtractor<T>(view, iso, options));
     };
     detail::Ticker ticker(options.progress, 2 * nz);
 
-    std::vector<int> order(static_cast<std::size_t>(ranges));
+    std::vector<int> order(static_cast<std::size_t>(plan.ranges()));
     std::iota(order.begin(), order.end(), 0);
-    std::vector<RangeCounts> counts(static_cast<std::size_t>(ranges));
+    std::vector<RangeCounts> counts(order.size());
     try {
         detail::for_each_range(n, order, options.executor, ticker, [&](int r, int t) {
             counts[static_cast<std::size_t>(r)] = with_extractor(r, t, [&](const detail::RangeExtractor<T>& x) {
@@ -94,14 +87,9 @@ Mesh detail::extract_passes(const GridView<T>& grid, double iso, const ExtractOp
         throw;
     }
     if (ticker.cancelled()) detail::throw_cancelled();
-    detail::RangeExtractor<T>::share_largest_sample(counts);
-    const std::vector<RangeOffsets> offsets = scan(counts);
-    const std::int64_t nv = offsets.back().first_vertex + counts.back().vertex_count();
-    const std::int64_t nt = offsets.back().first_triangle + counts.back().triangle_count();
-    if (nv >= static_cast<std::int64_t>(detail::kNoVertex)) {
-        throw Error(Status::too_large, "the mesh would have " + std::to_string(nv) +
-                                           " vertices, more than 32-bit indices can address");
-    }
+    const MeshLayout layout = lay_out(counts);
+    const std::vector<RangeOffsets>& offsets = layout.offsets;
+    const std::int64_t nv = layout.vertex_count, nt = layout.triangle_count;
     Mesh mesh;
     mesh.positions.resize(static_cast<std::size_t>(nv) * 3);
     if (options.normals) mesh.normals.resize(static_cast<std::size_t>(nv) * 3);

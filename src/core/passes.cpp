@@ -1,7 +1,10 @@
 // The public passes of passes.hpp (count, scan, emit_order, emit): the range extractor
-// (range_extractor.hpp) behind checks of what the caller hands it.
+// (range_extractor.hpp) behind checks of what the caller hands it; and how extract() runs them
+// (lay_out, plan_ranges, run_ranges), which callers running the passes themselves share.
 
 #include <algorithm>
+#include <cstdint>
+#include <limits>
 #include <numeric>
 #include <span>
 #include <string>
@@ -9,9 +12,12 @@
 
 #include "cmc33/error.hpp"
 #include "cmc33/passes.hpp"
+#include "bit_rows.hpp"
 #include "grid_checks.hpp"
+#include "parallel.hpp"
 #include "range_extractor.hpp"
 #include "sample_types.hpp"
+#include "schedule.hpp"
 
 namespace cmc33 {
 
@@ -101,6 +107,54 @@ std::vector<int> emit_order(std::span<const RangeCounts> ranges)
     return order;
 }
 
+MeshLayout lay_out(std::span<RangeCounts> ranges)
+{
+    double bound = 0;
+    for (const RangeCounts& c : ranges) bound = std::max(bound, c.sample_bound());
+    for (RangeCounts& c : ranges) c.share_sample_bound(bound);
+    MeshLayout layout;
+    layout.offsets = scan(ranges);
+    if (!ranges.empty()) {
+        layout.vertex_count = layout.offsets.back().first_vertex + ranges.back().vertex_count();
+        layout.triangle_count = layout.offsets.back().first_triangle + ranges.back().triangle_count();
+    }
+    if (layout.vertex_count >= static_cast<std::int64_t>(detail::kNoVertex)) {
+        throw Error(Status::too_large, "the mesh would have " + std::to_string(layout.vertex_count) +
+                                           " vertices, more than 32-bit indices can address");
+    }
+    return layout;
+}
+
+template <class T> RangePlan plan_ranges(const GridView<T>& grid, int threads, std::int64_t max_range_samples)
+{
+    const std::int64_t nz = grid.nz();
+    RangePlan plan;
+    plan.threads = detail::threads_for(threads, nz);
+    plan.window_planes = window_range_planes(grid);
+    const std::int64_t n = plan.threads;
+    std::int64_t ranges = n == 1 ? 1 : std::clamp<std::int64_t>(nz / 8, n, 8 * n);
+    const auto at_most = [&](std::int64_t planes) {
+        if (planes > 0) ranges = std::max(ranges, (nz + planes - 1) / planes);
+    };
+    at_most(plan.window_planes);
+    if (max_range_samples > 0) at_most(std::max<std::int64_t>(max_range_samples / std::max<std::int64_t>(grid.nx() * grid.ny(), 1), 1));
+    ranges = std::clamp<std::int64_t>(ranges, 1, std::numeric_limits<int>::max() - 1);
+    plan.first_planes.resize(static_cast<std::size_t>(ranges) + 1);
+    for (std::int64_t r = 0; r <= ranges; ++r) plan.first_planes[static_cast<std::size_t>(r)] = nz * r / ranges;
+    return plan;
+}
+
+void run_ranges(int threads, std::span<const int> order, const std::function<void(int range, int task)>& work,
+                const Progress& progress, const Executor& executor)
+{
+    detail::Ticker ticker(progress, static_cast<std::int64_t>(order.size()));
+    detail::for_each_range(std::max(threads, 1), order, executor, ticker, [&](int r, int task) {
+        work(r, task);
+        ticker.tick();
+    });
+    if (ticker.cancelled()) detail::throw_cancelled();
+}
+
 template <class T>
 void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out)
@@ -120,7 +174,8 @@ void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, co
 #define CMC33_INSTANTIATE(T)                                                                                    \
     template RangeCounts count<T>(const GridView<T>&, double, const ExtractOptions&, std::int64_t, std::int64_t);      \
     template void emit<T>(const GridView<T>&, double, const ExtractOptions&, const RangeCounts&, const RangeOffsets&, \
-                          const MeshSpans&);
+                          const MeshSpans&);                                                                  \
+    template RangePlan plan_ranges<T>(const GridView<T>&, int, std::int64_t);
 CMC33_FOR_EACH_SAMPLE_TYPE(CMC33_INSTANTIATE)
 #undef CMC33_INSTANTIATE
 

@@ -69,9 +69,6 @@ public:
         build_short_tilings();
     }
 
-    /// Gives every range the bound on |sample| of them all (which have read every sample).
-    static void share_largest_sample(std::vector<RangeCounts>& counts);
-
     /// Whether `c` was counted on a grid with these rows.
     static bool same_rows(const RangeCounts& c, const GridView<T>& g);
 

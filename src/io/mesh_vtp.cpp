@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "mesh_formats.hpp"
+#include "parallel.hpp"
 
 namespace cmc33::io::detail {
 namespace {
@@ -69,8 +70,7 @@ std::string compressed(const Array& a)
             }
         }
     };
-    const std::size_t threads =
-        std::min<std::size_t>(parts.size(), std::max(1u, std::thread::hardware_concurrency()));
+    const auto threads = static_cast<std::size_t>(cmc33::detail::threads_for(0, static_cast<std::int64_t>(parts.size())));
     std::vector<std::thread> pool; // std::thread: the WebAssembly build's libc++ has no jthread
     for (std::size_t k = 1; k < threads; ++k) {
         try {

@@ -177,7 +177,7 @@ void one_side(const Mesh& from, const Mesh& to, double spacing, int threads, dou
     const std::size_t nt = from.triangle_count();
     std::vector<std::uint8_t> used(from.vertex_count(), 0);
     for (const std::uint32_t v : from.triangles) used[v] = 1;
-    const int n_threads = detail::resolve_threads(threads);
+    const int n_threads = thread_count(threads);
     struct Part {
         double max = 0, sum = 0;
         std::int64_t count = 0;

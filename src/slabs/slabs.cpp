@@ -389,7 +389,7 @@ struct RangeRun::Impl {
 
     Impl(io::detail::PlaneReader& r, double i, SlabOptions o, std::int64_t a, std::int64_t b)
         : reader(r), iso(i), opt(std::move(o)), k0(a), k1(b), nz(r.layout().grid.dims[2]), grid(r.layout().grid),
-          plane_bytes(r.layout().plane_bytes()), threads(detail::resolve_threads(opt.extract.threads))
+          plane_bytes(r.layout().plane_bytes()), threads(thread_count(opt.extract.threads))
     {
         if (!(0 <= k0 && k0 <= k1 && k1 <= nz)) {
             throw Error(Status::invalid_argument, "slabs: planes [" + std::to_string(k0) + ", " + std::to_string(k1) +
@@ -660,7 +660,7 @@ struct RangeRun::Impl {
         layers.layer_first = {layer_first.data(), layer_first.size()};
         layers.k0 = has_below ? s.a - 1 : s.a;
         detail::GridCheckOptions o;
-        o.threads = detail::resolve_threads(opt.extract.threads);
+        o.threads = thread_count(opt.extract.threads);
         o.examples = 0;
         detail::GridGeometry alone; // the layer below by itself: its own slab's
         if (has_below && below_t > 0) {

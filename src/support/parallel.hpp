@@ -8,18 +8,19 @@
 #include <thread>
 #include <vector>
 
+#include "cmc33/threads.hpp"
+
 namespace cmc33::detail {
 
-inline int resolve_threads(int requested)
+/// The threads for `items` pieces of work (sample planes, fields, labels): thread_count(requested)
+/// (cmc33/threads.hpp), at most `items` and at least 1.
+inline int threads_for(int requested, std::int64_t items) noexcept
 {
-#if defined(__EMSCRIPTEN__) && !defined(__EMSCRIPTEN_PTHREADS__)
-    (void)requested;
-    return 1; // a WebAssembly build without pthreads has one thread: the pools are never used
-#endif
-    if (requested > 0) return requested;
-    const unsigned hw = std::thread::hardware_concurrency();
-    return hw == 0 ? 1 : static_cast<int>(hw);
+    return static_cast<int>(std::clamp<std::int64_t>(thread_count(requested), 1, std::max<std::int64_t>(items, 1)));
 }
+
+/// thread_count() under its former name (still used by labels.cpp; new code calls threads_for).
+inline int resolve_threads(int requested) noexcept { return thread_count(requested); }
 
 /// Calls body(thread_index, begin, end) on `threads` contiguous chunks of [0, n).
 template <class Body> void parallel_chunks(std::int64_t n, int threads, Body&& body)

@@ -109,7 +109,7 @@ std::optional<MeshTopology> structured_topology(const Mesh& mesh, const Extracte
 
 MeshCheck check_extracted_mesh(const Mesh& mesh, const ExtractedGrid& grid, const MeshCheckOptions& options)
 {
-    const int threads = detail::resolve_threads(options.threads);
+    const int threads = thread_count(options.threads);
     // the topology is a small part of the work: a fifth of the fraction reported
     const auto report = [&](double fraction) { return !options.progress || options.progress(fraction); };
     MeshCheck check;

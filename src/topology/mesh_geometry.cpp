@@ -54,7 +54,7 @@ class GeometryCheck {
 public:
     GeometryCheck(const Mesh& mesh, const MeshGeometryOptions& options) : mesh_(mesh), options_(options)
     {
-        threads_ = detail::resolve_threads(options.threads);
+        threads_ = thread_count(options.threads);
     }
 
     MeshGeometry run()

@@ -522,8 +522,7 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
         }
     }
     const std::int64_t total = options.cells + options.grids + options.closed + options.ties;
-    const int threads = static_cast<int>(std::clamp<std::int64_t>(
-        detail::resolve_threads(options.threads), 1, std::max<std::int64_t>(total, 1)));
+    const int threads = detail::threads_for(options.threads, total);
     verification::detail::Ticker tick(options.progress, total, nullptr);
 
     DatasetSummary summary;
@@ -715,8 +714,7 @@ VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerif
         verification::detail::check_methods(options.methods);
     }
     const auto total = static_cast<std::int64_t>(entries.size());
-    const int threads = static_cast<int>(
-        std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, total));
+    const int threads = detail::threads_for(options.threads, total);
     std::vector<std::vector<Tally>> tallies =
         verification::detail::make_tallies(threads, options.methods, external);
     std::atomic<std::int64_t> mismatched{0};

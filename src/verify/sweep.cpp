@@ -53,7 +53,7 @@ SweepReport sweep(const Volume& volume, const SweepOptions& options)
     const auto n = static_cast<std::int64_t>(options.isovalues.size());
     const std::size_t per_iso = options.methods.size();
     SweepReport report;
-    report.threads = static_cast<int>(std::clamp<std::int64_t>(detail::resolve_threads(options.threads), 1, n));
+    report.threads = detail::threads_for(options.threads, n);
     report.rows.resize(static_cast<std::size_t>(n) * per_iso);
     std::atomic<std::int64_t> none{0};
     verification::detail::Ticker tick(options.progress, n, &none);

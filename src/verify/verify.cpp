@@ -120,8 +120,7 @@ VerifyReport verify(const VerifyOptions& options)
     const std::array<std::int64_t, kFieldKindCount> counts{options.cells, options.grids, options.closed,
                                                            options.ties};
     const std::int64_t total = options.cells + options.grids + options.closed + options.ties;
-    const int threads = static_cast<int>(std::clamp<std::int64_t>(
-        detail::resolve_threads(options.threads), 1, std::max<std::int64_t>(total, 1)));
+    const int threads = detail::threads_for(options.threads, total);
     std::vector<std::vector<Tally>> tallies =
         verification::detail::make_tallies(threads, options.methods, false);
     std::atomic<std::int64_t> mismatched{0};

@@ -16,9 +16,12 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <numeric>
 #include <optional>
 #include <random>
 #include <span>
+#include <stdexcept>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -28,6 +31,7 @@
 #include "cmc33/passes.hpp"
 #include "cmc33/topology.hpp"
 #include "test_support.hpp"
+#include "parallel.hpp"
 #include "thread_pool.hpp"
 
 namespace {
@@ -790,4 +794,130 @@ TEST(Passes, PoolRunsEveryTaskOnceAndLeavesNoWorkerInAFinishedJob)
         worker_tasks += off_caller.load();
     }
     EXPECT_GT(worker_tasks, 0); // the workers did take part
+}
+
+TEST(Passes, ThreadCountIsTheRequestOrEveryCoreAndAtMostOnePerPiece)
+{
+    EXPECT_EQ(cmc33::thread_count(3), 3);
+    const int all = cmc33::thread_count(0);
+    EXPECT_GE(all, 1);
+    EXPECT_EQ(cmc33::thread_count(-2), all);
+    EXPECT_EQ(cmc33::detail::threads_for(8, 3), 3);
+    EXPECT_EQ(cmc33::detail::threads_for(2, 100), 2);
+    EXPECT_EQ(cmc33::detail::threads_for(5, 0), 1);
+    EXPECT_EQ(cmc33::detail::threads_for(0, std::int64_t{1} << 40), all);
+}
+
+TEST(Passes, PlanRunLayOutAndEmitGiveExtractsMeshForEveryPlan)
+{
+    const Volume v = noise({20, 17, 40}, 11);
+    const ExtractOptions opt{.normals = true, .threads = 1};
+    const cmc33::Mesh expected = cmc33::extract(v, 0.1, opt);
+    const std::int64_t plane = 20 * 17;
+    v.visit([&](auto g) {
+        EXPECT_EQ(cmc33::plan_ranges(g, 1).ranges(), 1) << "one thread: one range";
+        EXPECT_EQ(cmc33::plan_ranges(g, 4).ranges(), 5) << "threads: about nz / 8 ranges, at least one per thread";
+        EXPECT_EQ(cmc33::plan_ranges(g, 2).ranges(), 5);
+        EXPECT_EQ(cmc33::plan_ranges(g, 3).ranges(), 5);
+        EXPECT_EQ(cmc33::plan_ranges(g, 7).ranges(), 7);
+        for (const int threads : {1, 3, 64}) {
+            for (const std::int64_t samples : {std::int64_t{0}, std::int64_t{1}, 5 * plane, 7 * plane + 3}) {
+                const std::string what = std::to_string(threads) + " threads, ranges of " + std::to_string(samples) + " samples";
+                const cmc33::RangePlan plan = cmc33::plan_ranges(g, threads, samples);
+                EXPECT_EQ(plan.threads, std::min(threads, 40)) << what;
+                EXPECT_EQ(plan.window_planes, 0) << what;
+                ASSERT_GE(plan.ranges(), 1) << what;
+                EXPECT_EQ(plan.first_planes.front(), 0) << what;
+                EXPECT_EQ(plan.first_planes.back(), 40) << what;
+                for (int r = 0; r < plan.ranges(); ++r) {
+                    const std::int64_t planes = plan.first_planes[static_cast<std::size_t>(r) + 1] - plan.first_planes[static_cast<std::size_t>(r)];
+                    EXPECT_GE(planes, 1) << what;
+                    if (samples > 0) {
+                        EXPECT_LE(planes * plane, std::max(samples, plane)) << what;
+                    }
+                }
+                const auto k = [&plan](int r) { return plan.first_planes[static_cast<std::size_t>(r)]; };
+                std::vector<int> order(static_cast<std::size_t>(plan.ranges()));
+                std::iota(order.begin(), order.end(), 0);
+                std::vector<RangeCounts> counts(order.size());
+                cmc33::run_ranges(plan.threads, order, [&](int r, int) {
+                    counts[static_cast<std::size_t>(r)] = cmc33::count(g, 0.1, opt, k(r), k(r + 1));
+                });
+                const cmc33::MeshLayout layout = cmc33::lay_out(counts);
+                ASSERT_EQ(layout.vertex_count, static_cast<std::int64_t>(expected.vertex_count())) << what;
+                ASSERT_EQ(layout.triangle_count, static_cast<std::int64_t>(expected.triangle_count())) << what;
+                cmc33::Mesh m;
+                m.positions.resize(expected.positions.size());
+                m.normals.resize(expected.normals.size());
+                m.triangles.resize(expected.triangles.size());
+                cmc33::run_ranges(plan.threads, cmc33::emit_order(counts), [&](int r, int) {
+                    MeshSpans out;
+                    out.positions = m.positions.data();
+                    out.normals = m.normals.data();
+                    out.triangles = m.triangles.data();
+                    const auto i = static_cast<std::size_t>(r);
+                    cmc33::emit(g, 0.1, opt, counts[i], layout.offsets[i], out);
+                });
+                EXPECT_EQ(m.positions, expected.positions) << what;
+                EXPECT_EQ(m.normals, expected.normals) << what;
+                EXPECT_EQ(m.triangles, expected.triangles) << what;
+            }
+        }
+    });
+}
+
+TEST(Passes, RunRangesRunsEachRangeOnceRethrowsTheLowestErrorAndStops)
+{
+    std::vector<int> order(50);
+    std::iota(order.rbegin(), order.rend(), 0); // 49 first
+    for (const int threads : {1, 4}) {
+        std::vector<std::atomic<int>> runs(order.size());
+        std::atomic<int> bad_task{0};
+        cmc33::run_ranges(threads, order, [&](int r, int task) {
+            runs[static_cast<std::size_t>(r)].fetch_add(1);
+            if (task < 0 || task >= threads) bad_task.fetch_add(1);
+        });
+        for (std::size_t r = 0; r < runs.size(); ++r) EXPECT_EQ(runs[r].load(), 1) << threads << " threads, range " << r;
+        EXPECT_EQ(bad_task.load(), 0);
+
+        // ranges 30 and 7 throw: 7's error, though 30 comes first in the order
+        try {
+            cmc33::run_ranges(threads, order, [](int r, int) {
+                if (r == 30 || r == 7) throw std::runtime_error("range " + std::to_string(r));
+            });
+            ADD_FAILURE() << "no error";
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(std::string(e.what()), "range 7");
+        }
+
+        // progress says stop at its first call: Error{cancelled}; on one thread no range starts after it
+        std::atomic<int> ran{0};
+        std::vector<double> seen;
+        try {
+            cmc33::run_ranges(threads, order, [&](int, int) { ran.fetch_add(1); }, [&](double f) {
+                seen.push_back(f);
+                return false;
+            });
+            ADD_FAILURE() << "not cancelled";
+        } catch (const cmc33::Error& e) {
+            EXPECT_EQ(e.status(), cmc33::Status::cancelled) << e.what();
+        }
+        ASSERT_FALSE(seen.empty());
+        EXPECT_GT(seen[0], 0.0);
+        if (threads == 1) { // with more, the others may take every (empty) range before the stop lands
+            EXPECT_EQ(ran.load(), 1);
+        }
+
+        // the caller's executor runs the tasks
+        int batches = 0;
+        std::vector<int> taken;
+        cmc33::run_ranges(
+            threads, order, [&](int r, int) { taken.push_back(r); }, {},
+            [&](int n, const std::function<void(int)>& task) {
+                ++batches;
+                for (int t = 0; t < n; ++t) task(t); // one after the other: the first takes every range
+            });
+        EXPECT_EQ(batches, 1);
+        EXPECT_EQ(taken, order);
+    }
 }

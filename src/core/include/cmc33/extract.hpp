@@ -13,6 +13,7 @@
 #include <string_view>
 
 #include "cmc33/mesh.hpp"
+#include "cmc33/threads.hpp"
 #include "cmc33/volume.hpp"
 #include "cmc33/core_export.hpp"
 
@@ -60,7 +61,9 @@ using Progress = std::function<bool(double fraction)>;
 struct ExtractOptions {
     Method method = Method::cmc33;
     bool normals = false; ///< per-vertex normals from the field's gradient (central differences)
-    int threads = 0;      ///< 0: all cores. The mesh is byte-identical for every thread count.
+    /// thread_count(threads) (cmc33/threads.hpp: 0 is all cores), at most one per sample plane. The
+    /// mesh is byte-identical for every thread count.
+    int threads = 0;
     Progress progress{};  ///< optional: progress and cancellation
     Executor executor{};  ///< optional: where the `threads` tasks run
 };

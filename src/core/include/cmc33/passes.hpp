@@ -178,6 +178,19 @@ template <class T>
 CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
           const RangeOffsets& offsets, const MeshSpans& out);
 
+/// What the ranges of one mesh need between count() and emit(), as extract() does it.
+struct MeshLayout {
+    std::vector<RangeOffsets> offsets; ///< scan()'s, from ids 0
+    std::int64_t vertex_count = 0;     ///< the mesh's
+    std::int64_t triangle_count = 0;
+};
+
+/// Ranges that together cover a grid's planes [0, nz), in order: raises every range's sample
+/// bound to the largest of them (share_sample_bound(), so that emit()'s normals are extract()'s
+/// whatever the split), then scan()s them from 0.
+/// @throws Error{too_large} if the mesh has more vertices than 32-bit ids can address; scan()'s
+CMC33_CORE_EXPORT MeshLayout lay_out(std::span<RangeCounts> ranges);
+
 namespace detail {
 /// window()'s planes are this many samples longer than nx * ny: a cache line (see window.cpp).
 template <class T> inline constexpr std::int64_t kWindowPad = 64 / static_cast<std::int64_t>(sizeof(T));
@@ -205,5 +218,39 @@ std::int64_t window_range_planes(const GridView<T>& grid, std::int64_t bytes = s
     const std::int64_t plane = (grid.nx() * grid.ny() + detail::kWindowPad<T>) * static_cast<std::int64_t>(sizeof(T));
     return std::max<std::int64_t>(bytes / plane - 3, 1);
 }
+
+/// Experimental. How extract() splits a grid into ranges of sample planes and threads, for
+/// callers that run count() and emit() over ranges on threads themselves (run_ranges()).
+struct RangePlan {
+    int threads = 1; ///< thread_count(threads), at most one per range
+    /// ranges() + 1 entries from 0 to nz: range r is sample planes [first_planes[r], first_planes[r + 1])
+    std::vector<std::int64_t> first_planes;
+    /// window_range_planes(grid): 0 when count() and emit() read the grid in place; else each
+    /// range reads it through a window(), one buffer per thread, and has at most this many planes
+    std::int64_t window_planes = 0;
+    int ranges() const noexcept { return static_cast<int>(first_planes.size()) - 1; }
+};
+
+/// Experimental. extract()'s plan: thread_count(threads) threads, at most nz; one range for one
+/// thread, else about nz / 8 ranges, at least one and at most 8 per thread (more ranges than
+/// threads, taken in turn, end the threads together when the surface is spread unevenly over the
+/// planes; ranges of 8 planes or more keep the planes read twice, at their ends, few). Ranges are
+/// then cut finer, evenly, until each has at most window_planes planes (if not 0) and at most
+/// `max_range_samples` samples (if not 0; at least one plane): run_ranges() starts no range once
+/// asked to stop, so this bounds the wait for a stop. The mesh is the same for every plan.
+template <class T>
+CMC33_CORE_EXPORT RangePlan plan_ranges(const GridView<T>& grid, int threads, std::int64_t max_range_samples = 0);
+
+/// Experimental. The loop extract() runs its passes with: work(r, task) for every range r of
+/// `order` (the ranges' indices, each once: 0, 1, ... for count(), emit_order() for emit()) on
+/// `threads` tasks of `executor` (empty: the calling thread and the process's worker pool, as
+/// extract()), each task taking the next range of `order` when it is free. After each range,
+/// progress(ranges done / ranges), as ExtractOptions::progress is called (from a task's thread,
+/// never two calls at once, at most every few milliseconds); once it returns false no range
+/// starts. Every range that starts ends; then the error of the lowest range that threw is
+/// rethrown (the same whichever thread ran what), else Error{cancelled} if progress said stop.
+CMC33_CORE_EXPORT void run_ranges(int threads, std::span<const int> order,
+                                  const std::function<void(int range, int task)>& work, const Progress& progress = {},
+                                  const Executor& executor = {});
 
 } // namespace cmc33
