@@ -52,7 +52,7 @@ py::tuple label_surfaces_py(const py::array& labels, const Vec3& spacing, const 
     py::object front = to_numpy(std::move(r.front)), behind = to_numpy(std::move(r.behind));
     py::object interfaces = py::cast(PyMesh{std::move(r.interfaces), std::nullopt, normals});
     return py::make_tuple(interfaces, front, behind, per_label ? py::object(surfaces) : py::object(py::none()),
-                          r.present, r.selected, r.cells_two_labels, r.cells_many_labels);
+                          r.present, r.selected, r.cells_two_labels, r.cells_many_labels, r.cells_with_core);
 }
 
 } // namespace

@@ -53,12 +53,24 @@ def test_interfaces_carry_both_labels_and_every_surface_is_closed():
     assert np.all(result.front != result.behind)
     assert set(np.unique(np.concatenate([result.front, result.behind]))) <= set(result.present)
     assert result.cells_two_labels > 0 and result.cells_many_labels > 0
+    assert 0 <= result.cells_with_core <= result.cells_many_labels
     for label, mesh in result.surfaces.items():
         # each triangle with the label on a side, once
         assert mesh.triangle_count == np.count_nonzero((result.front == label) | (result.behind == label))
         assert cmc33.mesh_geometry(mesh).embedded, label
         topology = cmc33.mesh_topology(mesh)
-        assert topology.oriented and topology.nonmanifold_edges == 0, label
+        assert topology.oriented and topology.nonmanifold_edges == 0 and topology.nonmanifold_vertices == 0, label
+
+
+def test_a_label_of_two_pieces_in_a_cell_takes_its_core():
+    # label 1 on the opposite corners (0, 0, 0) and (1, 1, 1) of one cell: two pieces on its surface
+    labels = np.array([1, 2, 2, 3, 2, 3, 3, 1], dtype=np.uint8).reshape(2, 2, 2)
+    result = cmc33.label_surfaces(labels)
+    assert (result.cells_many_labels, result.cells_with_core) == (1, 1)
+    for label, mesh in result.surfaces.items():
+        topology = cmc33.mesh_topology(mesh)
+        assert topology.nonmanifold_edges == 0 and topology.nonmanifold_vertices == 0, label
+        assert topology.components == 1, label
 
 
 def test_two_labels_are_extracts_level_set():

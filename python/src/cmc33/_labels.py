@@ -32,8 +32,10 @@ class LabelSurfaces:
         Every label in the volume, ascending (the background too).
     selected : tuple of int
         The labels that got surfaces, ascending.
-    cells_two_labels, cells_many_labels : int
-        Cells holding two labels (cmc33's triangulation) and three or more (cones from the centre, or a core).
+    cells_two_labels, cells_many_labels, cells_with_core : int
+        Cells holding two labels (cmc33's triangulation), three or more (cones from the centre, or a
+        core), and of those the cells cut around a core (where a label's part of the cell's surface
+        is not one disk; docs/labels.md).
     """
 
     interfaces: Mesh
@@ -44,6 +46,7 @@ class LabelSurfaces:
     selected: Tuple[int, ...]
     cells_two_labels: int
     cells_many_labels: int
+    cells_with_core: int
 
 
 def _ranges(labels: LabelSelection) -> List[Tuple[int, int]]:
@@ -146,5 +149,5 @@ def label_surfaces(labels: Union[Volume, Any], *, select: LabelSelection = "all"
                                    vec3((0, 0, 0) if origin is None else origin, "origin"),
                                    IDENTITY if direction is None else mat3(direction), int(background), ranges,
                                    bool(normals), thread_count(threads), bool(surfaces))
-    interfaces, front, behind, per_label, present, selected, two, many = result
-    return LabelSurfaces(interfaces, front, behind, per_label, tuple(present), tuple(selected), two, many)
+    interfaces, front, behind, per_label, present, selected, two, many, core = result
+    return LabelSurfaces(interfaces, front, behind, per_label, tuple(present), tuple(selected), two, many, core)
