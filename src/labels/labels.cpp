@@ -486,7 +486,7 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
     } else {
         // z-ranges of cell layers, one per thread; the output does not depend on how many
         const std::int64_t layers = g.nz() - 1;
-        const int threads = static_cast<int>(std::min<std::int64_t>(detail::resolve_threads(options.threads), layers));
+        const int threads = detail::threads_for(options.threads, layers);
         std::vector<Part> parts(static_cast<std::size_t>(threads));
         detail::parallel_chunks(layers, threads, [&](int t, std::int64_t k0, std::int64_t k1) {
             Worker<T> worker(g, place, chosen, parts[static_cast<std::size_t>(t)]);

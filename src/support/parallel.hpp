@@ -19,9 +19,6 @@ inline int threads_for(int requested, std::int64_t items) noexcept
     return static_cast<int>(std::clamp<std::int64_t>(thread_count(requested), 1, std::max<std::int64_t>(items, 1)));
 }
 
-/// thread_count() under its former name (still used by labels.cpp; new code calls threads_for).
-inline int resolve_threads(int requested) noexcept { return thread_count(requested); }
-
 /// Calls body(thread_index, begin, end) on `threads` contiguous chunks of [0, n).
 template <class Body> void parallel_chunks(std::int64_t n, int threads, Body&& body)
 {
