@@ -59,7 +59,8 @@ const std::array<Pattern, 256>& patterns()
 
 namespace {
 
-int root_of(std::array<int, 8>& parent, int x)
+// The root of x in a union-find forest (parent[x] == x at a root).
+template <std::size_t N> int root_of(const std::array<int, N>& parent, int x)
 {
     while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)];
     return x;
@@ -102,9 +103,8 @@ FaceCut cut_faces(const std::array<std::int64_t, 8>& label)
             const auto distinct = std::unique(sorted.begin(), sorted.end()) - sorted.begin();
             if (distinct == 1) {
                 Piece& p = piece();
-                for (unsigned i = 0; i < 4; ++i) p.add(corner(q[i]), true);
+                for (unsigned i = 0; i < 4; ++i) p.add(corner(q[i]));
                 p.label = l[0];
-                p.outside = corner(q[0]);
                 continue;
             }
             // a label on both ends of a diagonal is joined across the face (the lower one when both
@@ -116,22 +116,20 @@ FaceCut cut_faces(const std::array<std::int64_t, 8>& label)
                 whole.label = joined;
                 for (unsigned i = 0; i < 4; ++i) {
                     if (l[i] == joined) {
-                        whole.add(corner(q[i]), true);
-                        whole.outside = corner(q[i]);
+                        whole.add(corner(q[i]));
                         continue;
                     }
-                    whole.add(mid(q[prev(i)], q[i]), false);
-                    whole.add(mid(q[i], q[next(i)]), false);
+                    whole.add(mid(q[prev(i)], q[i]));
+                    whole.add(mid(q[i], q[next(i)]));
                 }
                 for (unsigned i = 0; i < 4; ++i) {
                     if (l[i] == joined) continue;
                     segment(i, mid(q[prev(i)], q[i]));
                     Piece& p = piece();
-                    p.add(corner(q[i]), true);
-                    p.add(mid(q[i], q[next(i)]), false);
-                    p.add(mid(q[prev(i)], q[i]), false);
+                    p.add(corner(q[i]));
+                    p.add(mid(q[i], q[next(i)]));
+                    p.add(mid(q[prev(i)], q[i]));
                     p.label = l[i];
-                    p.outside = corner(q[i]);
                 }
                 join(q[diagonal0 && l[0] == joined ? 0 : 1], q[diagonal0 && l[0] == joined ? 2 : 3]);
                 continue;
@@ -153,15 +151,14 @@ FaceCut cut_faces(const std::array<std::int64_t, 8>& label)
             for (unsigned e = 0; e < n; ++e) {
                 const unsigned from = crossed[e], to = crossed[(e + 1) % n];
                 Piece& p = piece();
-                p.add(mid(q[from], q[next(from)]), false);
+                p.add(mid(q[from], q[next(from)]));
                 for (unsigned i = next(from);; i = next(i)) {
-                    p.add(corner(q[i]), true);
+                    p.add(corner(q[i]));
                     if (i == to) break;
                 }
-                p.add(mid(q[to], q[next(to)]), false);
-                if (distinct > 2) p.add(face_centre, false);
+                p.add(mid(q[to], q[next(to)]));
+                if (distinct > 2) p.add(face_centre);
                 p.label = l[next(from)];
-                p.outside = corner(q[next(from)]);
             }
         }
     }
@@ -189,10 +186,7 @@ std::optional<std::int64_t> core_label(const std::array<std::int64_t, 8>& label,
         std::array<int, 27> parent{};
         std::array<bool, 27> used{};
         for (int i = 0; i < 27; ++i) parent[static_cast<std::size_t>(i)] = i;
-        const auto find = [&](int x) {
-            while (parent[static_cast<std::size_t>(x)] != x) x = parent[static_cast<std::size_t>(x)];
-            return x;
-        };
+        const auto find = [&](int x) { return root_of(parent, x); };
         for (int i = 0; i < cut.n_segments; ++i) {
             const Segment& s = cut.segments[static_cast<std::size_t>(i)];
             if (s.near != *l && s.far != *l) continue;

@@ -76,18 +76,17 @@ struct Segment {
 struct Piece {
     std::array<Quad, 6> points{};
     int size = 0;
-    int first_corner = 0; ///< a corner of the square among the points: the fan's apex
     std::int64_t label = 0;
-    Quad outside{}; ///< a point off the core's face on the piece's side (a corner of the cell)
-    void add(const Quad& p, bool corner)
+    void add(const Quad& p) { points[static_cast<std::size_t>(size++)] = p; }
+    /// Where the piece's fan starts: its first corner of the square (every piece holds one; its
+    /// angle there is a right angle, so no triangle of the fan is flat).
+    int apex() const
     {
-        if (corner && !has_corner) {
-            first_corner = size;
-            has_corner = true;
-        }
-        points[static_cast<std::size_t>(size++)] = p;
+        const auto on_corner = [](const Quad& q) { return q[0] % 4 == 0 && q[1] % 4 == 0 && q[2] % 4 == 0; };
+        int i = 0;
+        while (!on_corner(points[static_cast<std::size_t>(i)])) ++i;
+        return i;
     }
-    bool has_corner = false;
 };
 
 // The curves and pieces of a cell's six faces, each face's made from its four labels only, so
@@ -146,10 +145,12 @@ template <class Emit> bool many_label_cell(const std::array<std::int64_t, 8>& la
     for (int i = 0; i < cut.n_pieces; ++i) {
         const Piece& p = cut.pieces[static_cast<std::size_t>(i)];
         if (p.label == *core) continue;
-        const auto at = [&](int k) {
-            return toward_centre(p.points[static_cast<std::size_t>((p.first_corner + k) % p.size)]);
-        };
-        for (int k = 1; k + 1 < p.size; ++k) oriented(at(0), at(k), at(k + 1), p.outside, p.label, *core);
+        // the piece's corner of the square lies off the core's face, on the piece's side
+        const int apex = p.apex();
+        const auto at = [&](int k) { return p.points[static_cast<std::size_t>((apex + k) % p.size)]; };
+        for (int k = 1; k + 1 < p.size; ++k) {
+            oriented(toward_centre(at(0)), toward_centre(at(k)), toward_centre(at(k + 1)), at(0), p.label, *core);
+        }
     }
     return true;
 }
