@@ -70,16 +70,44 @@ inline nlohmann::json parse(const Result& r)
     }
 }
 
-/// Exit 2, the message on one line containing every one of `parts`, then the --help line.
-inline void expect_usage_error(const Result& r, const std::vector<std::string>& parts)
+/// The usage-error contract: exit 2, "cmc33: ..." on stderr pointing to --help, nothing on stdout.
+inline void expect_usage_error(const Result& r)
 {
     EXPECT_EQ(r.code, 2) << r.err;
     EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
+    EXPECT_NE(r.err.find("--help"), std::string::npos) << r.err;
+    EXPECT_EQ(r.out, "");
+}
+
+/// expect_usage_error, and the message on one line containing every one of `parts`, then the --help line.
+inline void expect_usage_error(const Result& r, const std::vector<std::string>& parts)
+{
+    expect_usage_error(r);
     EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
     const std::string first = r.err.substr(0, r.err.find('\n'));
     for (const std::string& part : parts)
         EXPECT_NE(first.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
+}
+
+/// The error contract: exit 1, one line "cmc33: ..." on stderr containing every one of `parts`,
+/// nothing on stdout.
+inline void expect_failure(const Result& r, const std::vector<std::string>& parts)
+{
+    EXPECT_EQ(r.code, 1) << r.err;
+    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    for (const std::string& part : parts)
+        EXPECT_NE(r.err.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
     EXPECT_EQ(r.out, "");
+}
+
+/// The names of the entries of `dir`, sorted.
+inline std::vector<std::string> files_in(const std::filesystem::path& dir)
+{
+    std::vector<std::string> names;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
 }
 
 /// 8^3 uint8 samples of a ball: meshes to a closed surface at iso 100.

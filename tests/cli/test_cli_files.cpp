@@ -51,17 +51,6 @@ std::map<std::string, std::string> snapshot(const fs::path& dir)
     return files;
 }
 
-/// Exit 1 and one line "cmc33: ..." containing every one of `parts`, nothing on stdout.
-void expect_failure(const Result& r, const std::vector<std::string>& parts)
-{
-    EXPECT_EQ(r.code, 1) << r.err;
-    EXPECT_EQ(r.err.rfind("cmc33: ", 0), 0u) << r.err;
-    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-    for (const std::string& part : parts)
-        EXPECT_NE(r.err.find(part), std::string::npos) << "no '" << part << "' in " << r.err;
-    EXPECT_EQ(r.out, "");
-}
-
 constexpr const char* kNrrdFields = "NRRD0004\ntype: uint8\ndimension: 3\nsizes: 8 8 8\nencoding: raw\n";
 constexpr const char* kMetaFields = "NDims = 3\nDimSize = 8 8 8\nElementType = MET_UCHAR\n";
 
