@@ -40,6 +40,15 @@
 #include "cmc33/volume.hpp"
 #include "cmc33/core_export.hpp"
 
+/// Marks the functions of this header: experimental, their signatures may change in a minor
+/// release (extract() and the other headers' API do not). A consumer that defines
+/// CMC33_WARN_EXPERIMENTAL before including cmc33 gets a warning at every use, to find them.
+#ifdef CMC33_WARN_EXPERIMENTAL
+#define CMC33_EXPERIMENTAL [[deprecated("experimental cmc33 API (passes.hpp): it may change in a minor release")]]
+#else
+#define CMC33_EXPERIMENTAL
+#endif
+
 namespace cmc33 {
 
 namespace detail {
@@ -105,7 +114,9 @@ struct RangeOffsets {
 /// global numbering and element 0 of the triangle arrays triangle `first_triangle`, so a range (or
 /// an MPI rank) can be given just its slice of a larger output; emit() writes the ids in
 /// [offsets.first_vertex, + counts.vertex_count()) and the triangles in
-/// [offsets.first_triangle, + counts.triangle_count()). Null arrays are not written.
+/// [offsets.first_triangle, + counts.triangle_count()). Null arrays are not written. The members
+/// after `normals` (the extras: VTK filters' point data, scikit-image's values, Dask blocks) are
+/// experimental, as the functions of this header are.
 struct MeshSpans {
     float* positions = nullptr;          ///< 3 per vertex, world coordinates (required)
     std::uint32_t* triangles = nullptr;  ///< 3 per triangle, global vertex ids (required)
@@ -157,16 +168,18 @@ struct MeshSpans {
 /// ranges in parallel for threads (options.threads, progress and executor are not used here).
 /// @throws Error{invalid_argument} unless 0 <= k0 < k1 <= nz, or for the grid errors of extract()
 template <class T>
-CMC33_CORE_EXPORT RangeCounts count(const GridView<T>& grid, double iso, const ExtractOptions& options, std::int64_t k0, std::int64_t k1);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT RangeCounts count(const GridView<T>& grid, double iso,
+                                                       const ExtractOptions& options, std::int64_t k0, std::int64_t k1);
 
 /// Pass 2: consecutive offsets for ranges in order, starting at the given ids.
-CMC33_CORE_EXPORT std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges, std::int64_t first_vertex = 0,
-                               std::int64_t first_triangle = 0);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT std::vector<RangeOffsets> scan(std::span<const RangeCounts> ranges,
+                                                                    std::int64_t first_vertex = 0,
+                                                                    std::int64_t first_triangle = 0);
 
 /// The order in which threads should take ranges for emit: their indices, largest first (by
 /// vertices and triangles, what emit's time follows), ties in index order. The last ranges taken
 /// are then small, and the threads end nearly together however the surface is spread.
-CMC33_CORE_EXPORT std::vector<int> emit_order(std::span<const RangeCounts> ranges);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT std::vector<int> emit_order(std::span<const RangeCounts> ranges);
 
 /// Pass 3: writes the range's vertices (positions, and normals etc. where `out` has arrays for them)
 /// and triangles into `out`. `counts` must come from count() on the same grid, iso and method.
@@ -175,8 +188,9 @@ CMC33_CORE_EXPORT std::vector<int> emit_order(std::span<const RangeCounts> range
 /// @throws Error{internal} if the cells decided differently than in count() (a bug); Error{too_large}
 ///         if a vertex id passes 2^32 - 2
 template <class T>
-CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options, const RangeCounts& counts,
-          const RangeOffsets& offsets, const MeshSpans& out);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT void emit(const GridView<T>& grid, double iso, const ExtractOptions& options,
+                                               const RangeCounts& counts, const RangeOffsets& offsets,
+                                               const MeshSpans& out);
 
 /// What the ranges of one mesh need between count() and emit(), as extract() does it.
 struct MeshLayout {
@@ -189,7 +203,7 @@ struct MeshLayout {
 /// bound to the largest of them (share_sample_bound(), so that emit()'s normals are extract()'s
 /// whatever the split), then scan()s them from 0.
 /// @throws Error{too_large} if the mesh has more vertices than 32-bit ids can address; scan()'s
-CMC33_CORE_EXPORT MeshLayout lay_out(std::span<RangeCounts> ranges);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT MeshLayout lay_out(std::span<RangeCounts> ranges);
 
 namespace detail {
 /// window()'s planes are this many samples longer than nx * ny: a cache line (see window.cpp).
@@ -206,13 +220,15 @@ template <class T> inline constexpr std::int64_t kWindowPad = 64 / static_cast<s
 /// (planes) * (nx * ny + 64 / sizeof(T)) samples (the planes padded by a cache line).
 /// @throws Error{invalid_argument} unless 0 <= k0 < k1 <= nz
 template <class T>
-CMC33_CORE_EXPORT GridView<T> window(const GridView<T>& grid, std::int64_t k0, std::int64_t k1, Buffer<T>& buffer);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT GridView<T> window(const GridView<T>& grid, std::int64_t k0, std::int64_t k1,
+                                                       Buffer<T>& buffer);
 
 /// For callers that run the passes over ranges: 0 when count() and emit() read `grid` best in
 /// place (its x samples adjacent, stride 1), else the most planes a range may have for its
 /// window() to stay within `bytes` (at least 1; a window holds up to 3 planes more).
 template <class T>
-std::int64_t window_range_planes(const GridView<T>& grid, std::int64_t bytes = std::int64_t{4} << 20) noexcept
+CMC33_EXPERIMENTAL std::int64_t window_range_planes(const GridView<T>& grid,
+                                                    std::int64_t bytes = std::int64_t{4} << 20) noexcept
 {
     if (grid.strides[0] == 1 || grid.nx() < 2) return 0;
     const std::int64_t plane = (grid.nx() * grid.ny() + detail::kWindowPad<T>) * static_cast<std::int64_t>(sizeof(T));
@@ -239,7 +255,8 @@ struct RangePlan {
 /// `max_range_samples` samples (if not 0; at least one plane): run_ranges() starts no range once
 /// asked to stop, so this bounds the wait for a stop. The mesh is the same for every plan.
 template <class T>
-CMC33_CORE_EXPORT RangePlan plan_ranges(const GridView<T>& grid, int threads, std::int64_t max_range_samples = 0);
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT RangePlan plan_ranges(const GridView<T>& grid, int threads,
+                                                           std::int64_t max_range_samples = 0);
 
 /// Experimental. The loop extract() runs its passes with: work(r, task) for every range r of
 /// `order` (the ranges' indices, each once: 0, 1, ... for count(), emit_order() for emit()) on
@@ -249,7 +266,7 @@ CMC33_CORE_EXPORT RangePlan plan_ranges(const GridView<T>& grid, int threads, st
 /// never two calls at once, at most every few milliseconds); once it returns false no range
 /// starts. Every range that starts ends; then the error of the lowest range that threw is
 /// rethrown (the same whichever thread ran what), else Error{cancelled} if progress said stop.
-CMC33_CORE_EXPORT void run_ranges(int threads, std::span<const int> order,
+CMC33_EXPERIMENTAL CMC33_CORE_EXPORT void run_ranges(int threads, std::span<const int> order,
                                   const std::function<void(int range, int task)>& work, const Progress& progress = {},
                                   const Executor& executor = {});
 
