@@ -20,9 +20,9 @@ namespace cmc33::detail {
 template <class T>
 bool RangeExtractor<T>::same_rows(const RangeCounts& c, const GridView<T>& g)
 {
-    const std::int64_t planes = std::min(c.k1_, g.nz() - 1) - c.k0_ + 1;
-    return c.nx_ == g.nx() && c.ny_ == g.ny() && c.rows_.size() == static_cast<std::size_t>((c.k1_ - c.k0_) * g.ny()) &&
-           (c.k1_ == g.nz() || c.seam_first_.size() == static_cast<std::size_t>(g.ny()) + 1) &&
+    const std::int64_t planes = std::min(c.t_.k1, g.nz() - 1) - c.t_.k0 + 1;
+    return c.t_.nx == g.nx() && c.t_.ny == g.ny() && c.t_.rows.size() == static_cast<std::size_t>((c.t_.k1 - c.t_.k0) * g.ny()) &&
+           (c.t_.k1 == g.nz() || c.t_.seam_first.size() == static_cast<std::size_t>(g.ny()) + 1) &&
            planes > 0;
 }
 
@@ -30,9 +30,9 @@ template <class T>
 RangeCounts RangeExtractor<T>::count(std::int64_t k0, std::int64_t k1, double largest_sample, Ticker* ticker) const
 {
     RangeCounts c;
-    c.k0_ = k0, c.k1_ = k1, c.nx_ = nx_, c.ny_ = ny_, c.largest_sample_ = largest_sample;
-    c.iso_ = iso_, c.method_ = method_;
-    c.rows_.assign(static_cast<std::size_t>((k1 - k0) * ny_), {});
+    c.t_.k0 = k0, c.t_.k1 = k1, c.t_.nx = nx_, c.t_.ny = ny_, c.t_.largest_sample = largest_sample;
+    c.t_.iso = iso_, c.t_.method = method_;
+    c.t_.rows.assign(static_cast<std::size_t>((k1 - k0) * ny_), {});
     Scratch s(nx_, ny_);
     // Each sample row is classified once, straight into its slice of s.masks: the rows of plane
     // k + 1 as cell row j reaches them (j + 1; row 0 before), those of the range's first plane
@@ -65,7 +65,7 @@ RangeCounts RangeExtractor<T>::count(std::int64_t k0, std::int64_t k1, double la
     }
     if (k1 < nz_) {
         // plane k1 is the next range's: its rows' x/y edge vertices come first there
-        c.seam_first_.assign(static_cast<std::size_t>(ny_) + 1, 0);
+        c.t_.seam_first.assign(static_cast<std::size_t>(ny_) + 1, 0);
         const Word* const seam = s.masks.plane_words(k1); // classified with plane k1 - 1
         for (std::int64_t j = 0; j < ny_; ++j) {
             const Word* f = seam + j * st;
@@ -75,13 +75,13 @@ RangeCounts RangeExtractor<T>::count(std::int64_t k0, std::int64_t k1, double la
                 const EdgeWords e(f, fy, f, w, x_valid_[static_cast<std::size_t>(w)]);
                 xy += static_cast<std::uint32_t>(popcount(e.x) + popcount(e.y));
             }
-            c.seam_first_[static_cast<std::size_t>(j) + 1] = c.seam_first_[static_cast<std::size_t>(j)] + xy;
+            c.t_.seam_first[static_cast<std::size_t>(j) + 1] = c.t_.seam_first[static_cast<std::size_t>(j)] + xy;
         }
     }
     // every sample of planes k0..k1 has been classified, which also looked for non-finite ones
     if (s.scan.non_finite) scan_samples(g_, k0, std::min(k1, nz_ - 1)); // throws, naming the first
     // (for integer types, the type's bound: scan_samples reads nothing then)
-    c.largest_sample_ = std::max(largest_sample, std::is_floating_point_v<T> ? s.scan.largest : scan_samples(g_, k0, k0));
+    c.t_.largest_sample = std::max(largest_sample, std::is_floating_point_v<T> ? s.scan.largest : scan_samples(g_, k0, k0));
     // the rows hold their counts; turn them into first ids (the numbering of passes.hpp)
     std::int64_t v = 0, t = 0;
     const auto first_id = [&v, k0, k1](std::uint32_t& count) {
@@ -92,12 +92,12 @@ RangeCounts RangeExtractor<T>::count(std::int64_t k0, std::int64_t k1, double la
         v += std::exchange(count, static_cast<std::uint32_t>(v));
     };
     for (std::int64_t k = k0; k < k1; ++k) {
-        RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - k0) * ny_)];
+        RangeTable::Row* plane = &c.t_.rows[static_cast<std::size_t>((k - k0) * ny_)];
         for (std::int64_t j = 0; j < ny_; ++j) first_id(plane[j].xy_first);
         for (std::int64_t j = 0; j < ny_; ++j) first_id(plane[j].z_first);
         for (std::int64_t j = 0; j < ny_; ++j) t += std::exchange(plane[j].triangle_first, t);
     }
-    c.vertices_ = v, c.triangles_ = t;
+    c.t_.vertices = v, c.t_.triangles = t;
     return c;
 }
 
@@ -126,12 +126,12 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::count_row(std::int64_t j, std::int64
     if constexpr (std::is_floating_point_v<T>) {
         if (s.scan.non_finite) {
             // before any cell of these rows is decided (a NaN has no sign): name the first one
-            scan_samples(g_, c.k0_, std::min(c.k1_, nz_ - 1));
+            scan_samples(g_, c.t_.k0, std::min(c.t_.k1, nz_ - 1));
         }
     }
     const detail::RowSigns first = signs[0]; // all four rows all above or all below: the counts stay 0
     if (first != detail::RowSigns::mixed && signs[1] == first && signs[2] == first && signs[3] == first) return;
-    RangeCounts::Row& row = c.rows_[static_cast<std::size_t>(j + (k - c.k0_) * ny_)];
+    RangeTable::Row& row = c.t_.rows[static_cast<std::size_t>(j + (k - c.t_.k0) * ny_)];
     std::uint32_t xy = 0, z = 0;
     std::int64_t interior = 0, triangles = 0;
     std::int64_t lo = nx_, hi = 0;
@@ -154,11 +154,11 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::count_row(std::int64_t j, std::int64
             if (tl == nullptr) {
                 std::uint8_t decision = 0;
                 tl = &decide_cell(64 * w + b, j, k, code, subcase, decision);
-                c.decisions_.push_back(decision);
+                c.t_.decisions.push_back(decision);
             }
             interior += tl->interior_count;
             triangles += tl->triangle_count;
-            ++c.stats_.cells_per_subcase[static_cast<std::size_t>(subcase)];
+            ++c.t_.stats.cells_per_subcase[static_cast<std::size_t>(subcase)];
         }
     }
     if (hi > lo) row.lo = static_cast<std::int32_t>(lo), row.hi = static_cast<std::int32_t>(hi);

@@ -24,25 +24,25 @@ namespace cmc33::detail {
 template <class T>
 void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, const MeshSpans& out, Ticker* ticker) const
 {
-    const std::int64_t k0 = c.k0_, k1 = c.k1_;
-    const std::int64_t seam = c.seam_first_.empty() ? 0 : c.seam_first_.back();
-    const std::int64_t next = off.first_vertex + c.vertices_;
+    const std::int64_t k0 = c.t_.k0, k1 = c.t_.k1;
+    const std::int64_t seam = c.t_.seam_first.empty() ? 0 : c.t_.seam_first.back();
+    const std::int64_t next = off.first_vertex + c.t_.vertices;
     if (off.first_vertex < 0 || off.first_triangle < 0 ||
         next + seam > static_cast<std::int64_t>(kNoVertex)) {
         throw Error(Status::too_large, "the mesh would have vertex ids up to " + std::to_string(next + seam) +
                                            ", more than 32-bit indices can address");
     }
-    if (!(c.iso_ == iso_) || c.method_ != method_) {
+    if (!(c.t_.iso == iso_) || c.t_.method != method_) {
         // emit uses count's classification and decisions: they must be of this isovalue and method
-        throw Error(Status::invalid_argument, "emit: the counts are of iso " + std::to_string(c.iso_) + ", method " +
-                                                  std::string(method_name(c.method_)) + "; expected iso " +
+        throw Error(Status::invalid_argument, "emit: the counts are of iso " + std::to_string(c.t_.iso) + ", method " +
+                                                  std::string(method_name(c.t_.method)) + "; expected iso " +
                                                   std::to_string(iso_) + ", method " +
                                                   std::string(method_name(method_)) + ", as given to emit");
     }
-    if ((c.vertices_ > 0 && out.positions == nullptr) || (c.triangles_ > 0 && out.triangles == nullptr)) {
+    if ((c.t_.vertices > 0 && out.positions == nullptr) || (c.t_.triangles > 0 && out.triangles == nullptr)) {
         throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
     }
-    const Emit e{c, off, out, gradient_scale(c.largest_sample_)};
+    const Emit e{c, off, out, gradient_scale(c.t_.largest_sample)};
     Scratch s(nx_, ny_);
     if (out.vertex_cell_ranges) s.ranges.emplace(nx_, ny_);
     std::size_t decision = 0; // the next of count's decisions
@@ -53,10 +53,10 @@ void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, cons
     case Outputs::all: finished = emit_planes<Outputs::all>(e, s, ticker, decision); break;
     }
     if (!finished) return;
-    if (decision != c.decisions_.size()) {
+    if (decision != c.t_.decisions.size()) {
         throw Error(Status::internal, "emit met " + std::to_string(decision) + " cells with a face or interior test in planes " +
                                           std::to_string(k0) + " to " + std::to_string(k1) + ", count " +
-                                          std::to_string(c.decisions_.size()) +
+                                          std::to_string(c.t_.decisions.size()) +
                                           ": the samples, isovalue or method differ between the passes, or a bug in cmc33");
     }
 }
@@ -64,18 +64,18 @@ void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, cons
 template <class T>
 typename RangeExtractor<T>::RowSpan RangeExtractor<T>::span_of(const RangeCounts& c, std::int64_t j, std::int64_t k) const
 {
-    const std::size_t r = static_cast<std::size_t>(j + (k - c.k0_) * ny_);
-    const RangeCounts::Row& row = c.rows_[r];
-    const RangeCounts::Row& first = c.rows_[static_cast<std::size_t>((k - c.k0_) * ny_)];
+    const std::size_t r = static_cast<std::size_t>(j + (k - c.t_.k0) * ny_);
+    const RangeTable::Row& row = c.t_.rows[r];
+    const RangeTable::Row& first = c.t_.rows[static_cast<std::size_t>((k - c.t_.k0) * ny_)];
     const bool last_row = j + 1 == ny_;
-    const bool last_plane = k + 1 == c.k1_;
+    const bool last_plane = k + 1 == c.t_.k1;
     RowSpan s{};
     s.xy0 = row.xy_first;
-    s.xy1 = last_row ? first.z_first : c.rows_[r + 1].xy_first;
+    s.xy1 = last_row ? first.z_first : c.t_.rows[r + 1].xy_first;
     s.z0 = row.z_first;
-    s.v1 = !last_row ? c.rows_[r + 1].z_first : last_plane ? c.vertices_ : c.rows_[r + 1].xy_first;
+    s.v1 = !last_row ? c.t_.rows[r + 1].z_first : last_plane ? c.t_.vertices : c.t_.rows[r + 1].xy_first;
     s.t0 = row.triangle_first;
-    s.t1 = !last_row ? c.rows_[r + 1].triangle_first : last_plane ? c.triangles_ : c.rows_[r + 1].triangle_first;
+    s.t1 = !last_row ? c.t_.rows[r + 1].triangle_first : last_plane ? c.t_.triangles : c.t_.rows[r + 1].triangle_first;
     s.lo = row.lo, s.hi = row.hi;
     return s;
 }
@@ -85,8 +85,8 @@ template <Outputs kOut>
 bool RangeExtractor<T>::emit_planes(const Emit& e, Scratch& s, Ticker* ticker, std::size_t& decision) const
 {
     const RangeCounts& c = e.c;
-    for (std::int64_t k = c.k0_; k < c.k1_; ++k) {
-        const RangeCounts::Row* plane = &c.rows_[static_cast<std::size_t>((k - c.k0_) * ny_)];
+    for (std::int64_t k = c.t_.k0; k < c.t_.k1; ++k) {
+        const RangeTable::Row* plane = &c.t_.rows[static_cast<std::size_t>((k - c.t_.k0) * ny_)];
         for (std::int64_t j = 0; j < ny_; ++j) {
             // an empty trim range: no crossed edge or cell, so nothing to emit (most rows of a
             // CT volume; cheaper than span_of)
@@ -118,10 +118,10 @@ typename RangeExtractor<T>::CellsAround RangeExtractor<T>::cells_around(std::int
     CellRangeRows& rows = *s.ranges;
     const auto cell_row = [&](std::int64_t cj, std::int64_t ck) {
         // cells outside the grid, and the previous range's plane (edge_cell_range() there)
-        const bool exists = cj >= 0 && cj + 1 < ny_ && ck >= e.c.k0_ && ck + 1 < nz_;
+        const bool exists = cj >= 0 && cj + 1 < ny_ && ck >= e.c.t_.k0 && ck + 1 < nz_;
         return exists ? rows.row(cj, ck) : rows.zero();
     };
-    return {{cell_row(j - 1, k - 1), cell_row(j, k - 1)}, {cell_row(j - 1, k), cell_row(j, k)}, k == e.c.k0_ && k > 0};
+    return {{cell_row(j - 1, k - 1), cell_row(j, k - 1)}, {cell_row(j - 1, k), cell_row(j, k)}, k == e.c.t_.k0 && k > 0};
 }
 
 template <class T>
@@ -177,14 +177,14 @@ CMC33_ALWAYS_INLINE const std::uint32_t* RangeExtractor<T>::row_ids(std::int64_t
         interior = *end;
         return ids;
     }
-    if (k == e.c.k1_) {
+    if (k == e.c.t_.k1) {
         // the next range's first plane: its x/y edge ids follow this range's last vertex
         *end = interior = -1; // not this range's row: no vertex of it is written
-        const std::int64_t seam0 = e.c.seam_first_[static_cast<std::size_t>(j)];
-        if (seam0 == e.c.seam_first_[static_cast<std::size_t>(j) + 1]) return ids; // nothing crosses: never read
+        const std::int64_t seam0 = e.c.t_.seam_first[static_cast<std::size_t>(j)];
+        if (seam0 == e.c.t_.seam_first[static_cast<std::size_t>(j) + 1]) return ids; // nothing crosses: never read
         const Word* f = flags(j, k, s);
         const Word* fy = j + 1 < ny_ ? flags(j + 1, k, s) : f;
-        auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.vertices_ + seam0);
+        auto xy = static_cast<std::uint32_t>(e.off.first_vertex + e.c.t_.vertices + seam0);
         for (std::int64_t w = 0; w < words_; ++w) {
             const EdgeWords edges(f, fy, f, w, x_valid_[static_cast<std::size_t>(w)]);
             for (Word bits = edges.x | edges.y; bits != 0; bits &= bits - 1) {
@@ -194,7 +194,7 @@ CMC33_ALWAYS_INLINE const std::uint32_t* RangeExtractor<T>::row_ids(std::int64_t
                 if ((edges.y >> b) & 1u) ids[3 * i + 1] = xy++;
             }
         }
-        if (xy != e.off.first_vertex + e.c.vertices_ + e.c.seam_first_[static_cast<std::size_t>(j) + 1]) {
+        if (xy != e.off.first_vertex + e.c.t_.vertices + e.c.t_.seam_first[static_cast<std::size_t>(j) + 1]) {
             throw_mismatch("x/y edge vertices of the next range's first plane", j, k);
         }
         return ids;
@@ -469,7 +469,7 @@ int RangeExtractor<T>::emit_cell(std::int64_t i, std::int64_t j, std::int64_t k,
               const std::uint8_t* padded_table, const RowSpan& r, const Emit& e,
               std::int64_t tri, std::uint32_t* o, std::int64_t& vertex, std::size_t& decision) const
 {
-    const std::vector<std::uint8_t>& decisions = e.c.decisions_;
+    const std::vector<std::uint8_t>& decisions = e.c.t_.decisions;
     const detail::Tiling* tl = fixed_tiling_[code];
     if (tl == nullptr) {
         tl = decision < decisions.size() ? replay(code, decisions[decision]) : nullptr;

@@ -164,7 +164,7 @@ private:
         /// One past the range's last triangle id: a short tiling's fixed-size copy may write past
         /// its row's triangles into those of the range's next rows, which this thread writes
         /// later, but not past the range's (another thread's, or the end of the caller's output).
-        std::int64_t copy_end() const { return off.first_triangle + c.triangles_; }
+        std::int64_t copy_end() const { return off.first_triangle + c.t_.triangles; }
     };
 
     /// One thread's working memory: above-flags of three slices (3 nx ny / 8 bytes), vertex ids

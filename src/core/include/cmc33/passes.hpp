@@ -53,55 +53,65 @@ namespace cmc33 {
 
 namespace detail {
 template <class T> class RangeExtractor; // src/core/range_extractor.hpp
-}
 
-/// What count() found in one range: the number of vertices and triangles, and per sample row the
-/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row and
-/// one per cell with a face or interior test (its decision, which emit() replays).
-class RangeCounts {
-public:
-    std::int64_t k0() const noexcept { return k0_; }
-    std::int64_t k1() const noexcept { return k1_; }
-    std::int64_t vertex_count() const noexcept { return vertices_; }
-    std::int64_t triangle_count() const noexcept { return triangles_; }
-    /// Crossed cells of the range per subcase (see subcase_name()).
-    const ExtractStats& stats() const noexcept { return stats_; }
-    /// A bound on |sample| over the planes the range read, which scales emit()'s gradients when
-    /// samples come near the double range. extract() gives every range the largest bound of them
-    /// all; ranges counted apart (MPI ranks, out-of-core slabs) get extract()'s normals byte for
-    /// byte by doing the same: share_sample_bound(the largest sample_bound() of all ranges).
-    double sample_bound() const noexcept { return largest_sample_; }
-    /// The first vertex of sample plane k and the first triangle of cell layer k, counted from the
-    /// range's first (k0 <= k < k1).
-    std::int64_t plane_first_vertex(std::int64_t k) const noexcept { return rows_[static_cast<std::size_t>((k - k0_) * ny_)].xy_first; }
-    std::int64_t plane_first_triangle(std::int64_t k) const noexcept
-    {
-        return rows_[static_cast<std::size_t>((k - k0_) * ny_)].triangle_first;
-    }
-    /// Raises the bound to `bound` (never lowers it: a lower bound could overflow the gradients).
-    void share_sample_bound(double bound) noexcept { largest_sample_ = bound > largest_sample_ ? bound : largest_sample_; }
-
-private:
-    template <class T> friend class detail::RangeExtractor;
+/// What a RangeCounts holds: read and written by the passes alone (src/core/count.cpp, emit.cpp),
+/// its layout may change in any release.
+struct RangeTable {
     struct Row { // 24 bytes: vertex ids fit 32 bits (a range's count is checked), triangles may not
         std::int64_t triangle_first = 0;
         std::uint32_t xy_first = 0; ///< first id of the row's x/y edge vertices (range-relative)
         std::uint32_t z_first = 0;  ///< first id of its z edge vertices, then its cells' interior ones
         std::int32_t lo = 0, hi = 0; ///< samples [lo, hi) own every crossed edge and cell of the row
     };
-    std::int64_t k0_ = 0, k1_ = 0, nx_ = 0, ny_ = 0;
-    std::int64_t vertices_ = 0, triangles_ = 0;
-    double largest_sample_ = 0;            ///< bound on |sample| near the range (normals' scaling)
-    double iso_ = 0;                       ///< the isovalue and method counted (emit checks them)
-    Method method_ = Method::cmc33;
+    std::int64_t k0 = 0, k1 = 0, nx = 0, ny = 0;
+    std::int64_t vertices = 0, triangles = 0;
+    double largest_sample = 0; ///< bound on |sample| near the range (normals' scaling)
+    double iso = 0;            ///< the isovalue and method counted (emit checks them)
+    Method method = Method::cmc33;
     /// (k1 - k0) * ny rows, row (j, k) at j + (k - k0) * ny. A Buffer (mesh.hpp), as the mesh is: its
     /// megabytes (1.5 MiB for 256^3) come in huge pages, kept for the next count of the same size.
-    Buffer<Row> rows_;
-    std::vector<std::int64_t> seam_first_; ///< plane k1's rows: first x/y edge vertex (next range's ids)
+    Buffer<Row> rows;
+    std::vector<std::int64_t> seam_first; ///< plane k1's rows: first x/y edge vertex (next range's ids)
     /// One byte per cell with a face or interior test, in the order count met them: its decision,
     /// which emit replays instead of deciding again
-    std::vector<std::uint8_t> decisions_;
-    ExtractStats stats_{};
+    std::vector<std::uint8_t> decisions;
+    ExtractStats stats{};
+};
+} // namespace detail
+
+/// What count() found in one range: the number of vertices and triangles, and per sample row the
+/// numbers emit() needs to place them. Opaque apart from the accessors; 24 bytes per sample row and
+/// one per cell with a face or interior test (its decision, which emit() replays).
+class RangeCounts {
+public:
+    std::int64_t k0() const noexcept { return t_.k0; }
+    std::int64_t k1() const noexcept { return t_.k1; }
+    std::int64_t vertex_count() const noexcept { return t_.vertices; }
+    std::int64_t triangle_count() const noexcept { return t_.triangles; }
+    /// Crossed cells of the range per subcase (see subcase_name()).
+    const ExtractStats& stats() const noexcept { return t_.stats; }
+    /// A bound on |sample| over the planes the range read, which scales emit()'s gradients when
+    /// samples come near the double range. extract() gives every range the largest bound of them
+    /// all; ranges counted apart (MPI ranks, out-of-core slabs) get extract()'s normals byte for
+    /// byte by doing the same: share_sample_bound(the largest sample_bound() of all ranges).
+    double sample_bound() const noexcept { return t_.largest_sample; }
+    /// The first vertex of sample plane k and the first triangle of cell layer k, counted from the
+    /// range's first (k0 <= k < k1).
+    std::int64_t plane_first_vertex(std::int64_t k) const noexcept { return row(k).xy_first; }
+    std::int64_t plane_first_triangle(std::int64_t k) const noexcept { return row(k).triangle_first; }
+    /// Raises the bound to `bound` (never lowers it: a lower bound could overflow the gradients).
+    void share_sample_bound(double bound) noexcept
+    {
+        t_.largest_sample = bound > t_.largest_sample ? bound : t_.largest_sample;
+    }
+
+private:
+    template <class T> friend class detail::RangeExtractor;
+    const detail::RangeTable::Row& row(std::int64_t k) const noexcept
+    {
+        return t_.rows[static_cast<std::size_t>((k - t_.k0) * t_.ny)];
+    }
+    detail::RangeTable t_;
 };
 
 /// Where a range's vertices and triangles go in the caller's numbering.
