@@ -6,6 +6,7 @@
 #include "seam_topology.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <limits>
 #include <string>
@@ -35,6 +36,80 @@ void sort_keys(std::vector<std::uint64_t>& keys)
         for (std::size_t j = 0; j < n; ++j) rank += in[j] < in[i] ? 1 : 0;
         keys[rank] = in[i];
     }
+}
+
+/// Union-find over the ring slots of one vertex: a fixed array for the usual few (no allocation,
+/// no ranks: its trees stay shallow), the general one beyond.
+class SlotSets {
+public:
+    void reset(std::uint32_t n)
+    {
+        small_ = n <= kSmall;
+        if (!small_) {
+            big_.reset(n);
+            return;
+        }
+        for (std::uint32_t i = 0; i < n; ++i) parent_[i] = static_cast<std::uint8_t>(i);
+    }
+    /// Merges the sets of a and b; false if they were one already.
+    bool unite(std::uint32_t a, std::uint32_t b)
+    {
+        if (!small_) return big_.unite(a, b);
+        a = find(a);
+        b = find(b);
+        if (a == b) return false;
+        parent_[a] = static_cast<std::uint8_t>(b);
+        return true;
+    }
+
+private:
+    std::uint32_t find(std::uint32_t x)
+    {
+        while (parent_[x] != x) {
+            parent_[x] = parent_[parent_[x]];
+            x = parent_[x];
+        }
+        return x;
+    }
+    static constexpr std::uint32_t kSmall = 64;
+    std::array<std::uint8_t, kSmall> parent_{};
+    bool small_ = true;
+    UnionFind big_;
+};
+
+/// The usual vertex, found without sorting its ring: every edge at it is used twice, once in each
+/// direction (each slot's next vertex is exactly one slot's previous one, and those slots are all
+/// different). Then its fans are the cycles of that matching; returns false (nothing decided)
+/// for any other ring or more than 16 slots. `ring` holds (next, previous) per slot.
+bool closed_ring(const std::uint32_t* ring, std::uint32_t count, std::uint32_t v, std::int64_t& edges, std::uint32_t& fans)
+{
+    constexpr std::uint32_t kMax = 16;
+    if (count > kMax) return false;
+    std::uint8_t match[kMax];
+    std::uint32_t taken = 0;
+    std::int64_t larger = 0;
+    for (std::uint32_t s = 0; s < count; ++s) {
+        const std::uint32_t w = ring[2 * s];
+        std::uint32_t found = 0, at = 0;
+        for (std::uint32_t t = 0; t < count; ++t) {
+            const bool same = ring[2 * t + 1] == w;
+            found += same ? 1 : 0;
+            at = same ? t : at;
+        }
+        if (found != 1 || (taken >> at & 1u) != 0) return false;
+        taken |= 1u << at;
+        match[s] = static_cast<std::uint8_t>(at);
+        larger += w > v ? 1 : 0;
+    }
+    std::uint32_t seen = 0, cycles = 0;
+    for (std::uint32_t s = 0; s < count; ++s) {
+        if ((seen >> s & 1u) != 0) continue;
+        ++cycles;
+        for (std::uint32_t t = s; (seen >> t & 1u) == 0; t = match[t]) seen |= 1u << t;
+    }
+    edges += larger;
+    fans = cycles;
+    return true;
 }
 
 /// Node numbers for union-find roots, given in order of first appearance.
@@ -88,6 +163,7 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
 
     // The next slab's vertices this slab's triangles use: its upper side.
     std::vector<std::uint32_t> upper;
+    std::uint32_t upper_hi = 0; // the largest of them
     for (std::size_t t = 0; t < tri_count; ++t) {
         const std::uint32_t* c = &tri[3 * t];
         for (int q = 0; q < 3; ++q) {
@@ -99,13 +175,35 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
         }
         if (is_degenerate(c[0], c[1], c[2])) continue;
         for (int q = 0; q < 3; ++q)
-            if (c[q] >= v1) upper.push_back(c[q]);
+            if (c[q] >= v1) {
+                upper.push_back(c[q]);
+                upper_hi = std::max(upper_hi, c[q]);
+            }
     }
-    std::sort(upper.begin(), upper.end());
-    upper.erase(std::unique(upper.begin(), upper.end()), upper.end());
+    // Local numbers: own vertices first, then the upper side's in id order. The upper ids are
+    // the first ones of the next slab, close together: numbered through a table over their
+    // range, unless that range is far wider than their count.
+    constexpr auto kUnused = std::numeric_limits<std::uint32_t>::max();
+    std::vector<std::uint32_t> upper_local; // per id v1 + i: its local number, or kUnused
+    const std::int64_t upper_span = upper.empty() ? 0 : std::int64_t{upper_hi} - v1 + 1;
+    if (!upper.empty() && upper_span <= 4 * static_cast<std::int64_t>(upper.size()) + 1024) {
+        upper_local.assign(static_cast<std::size_t>(upper_span), kUnused);
+        for (const std::uint32_t id : upper) upper_local[static_cast<std::size_t>(id - v1)] = 0;
+        upper.clear();
+        for (std::size_t i = 0; i < upper_local.size(); ++i) {
+            if (upper_local[i] == kUnused) continue;
+            upper_local[i] = static_cast<std::uint32_t>(n + upper.size());
+            upper.push_back(static_cast<std::uint32_t>(v1 + static_cast<std::int64_t>(i)));
+        }
+    } else {
+        std::sort(upper.begin(), upper.end());
+        upper.erase(std::unique(upper.begin(), upper.end()), upper.end());
+    }
     const std::size_t total = n + upper.size();
     const auto local = [&](std::uint32_t id) -> std::uint32_t {
         if (id < v1) return static_cast<std::uint32_t>(id - v0);
+        const auto at = static_cast<std::size_t>(id - v1);
+        if (at < upper_local.size() && upper_local[at] != kUnused) return upper_local[at];
         return static_cast<std::uint32_t>(n + static_cast<std::size_t>(std::lower_bound(upper.begin(), upper.end(), id) - upper.begin()));
     };
 
@@ -162,12 +260,17 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
     std::vector<std::uint8_t> on_loop(total, 0), component_boundary(total, 0);
     std::vector<std::uint32_t> pending; // own vertices with a boundary edge but no own triangle
     std::vector<std::uint64_t> keys;
-    UnionFind fan;
+    SlotSets fan;
     for (std::size_t x = 0; x < n; ++x) {
         const std::uint32_t begin = start[x], count = start[x + 1] - begin;
         if (count == 0) continue;
         ++r.vertices_;
         const auto v = static_cast<std::uint32_t>(v0 + static_cast<std::int64_t>(x));
+        // each edge used twice, consistently oriented: its edges to larger ids and its fans
+        if (std::uint32_t fans = 0; closed_ring(&rings[2 * static_cast<std::size_t>(begin)], count, v, r.edges_, fans)) {
+            if (fans > 1) ++r.nonmanifold_vertices_;
+            continue;
+        }
         keys.resize(2 * static_cast<std::size_t>(count));
         for (std::uint32_t slot = 0; slot < count; ++slot) {
             const std::uint32_t* ring = &rings[2 * static_cast<std::size_t>(begin + slot)];
@@ -213,14 +316,18 @@ SeamTopology SeamTopology::of_slab(const SlabTriangles& slab)
 
     // The outer sides: own vertices the ghost layer uses (lower), the next slab's (upper).
     std::vector<std::uint32_t> lower;
-    for (std::size_t t = 0; t < below_count; ++t) {
-        const std::uint32_t* c = &below[3 * t];
-        if (is_degenerate(c[0], c[1], c[2])) continue;
-        for (int q = 0; q < 3; ++q)
-            if (own(c[q])) lower.push_back(c[q]);
+    if (below_count > 0) {
+        // marked per own vertex, then listed in id order (no sort)
+        std::vector<std::uint8_t> in_lower(n, 0);
+        for (std::size_t t = 0; t < below_count; ++t) {
+            const std::uint32_t* c = &below[3 * t];
+            if (is_degenerate(c[0], c[1], c[2])) continue;
+            for (int q = 0; q < 3; ++q)
+                if (own(c[q])) in_lower[c[q] - v0] = 1;
+        }
+        for (std::size_t x = 0; x < n; ++x)
+            if (in_lower[x]) lower.push_back(static_cast<std::uint32_t>(v0 + static_cast<std::int64_t>(x)));
     }
-    std::sort(lower.begin(), lower.end());
-    lower.erase(std::unique(lower.begin(), lower.end()), lower.end());
     std::sort(pending.begin(), pending.end());
     NodeMap component_nodes(total), loop_nodes(total);
     const auto side = [&](const std::vector<std::uint32_t>& ids, Side& s) {
