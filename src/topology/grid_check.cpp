@@ -30,6 +30,15 @@
 #include "cmc33/error.hpp"
 #include "exact_geometry.hpp"
 
+// test_pair() is the rare path of the pair walk: kept out of its callers, their loops stay small
+#if defined(__GNUC__) || defined(__clang__)
+#define CMC33_NOINLINE [[gnu::noinline]]
+#elif defined(_MSC_VER)
+#define CMC33_NOINLINE __declspec(noinline)
+#else
+#define CMC33_NOINLINE
+#endif
+
 namespace cmc33::detail {
 namespace {
 
@@ -274,6 +283,15 @@ private:
         axis_aligned_ = true;
     }
 
+    /// The cell [c, c + 1) of `cells` along an axis that holds index coordinate x, the nearest one
+    /// for x outside them (0 for NaN).
+    static std::int64_t cell_at(double x, std::int64_t cells)
+    {
+        if (!(x >= 1)) return 0;
+        if (x >= static_cast<double>(cells - 1)) return cells - 1;
+        return static_cast<std::int64_t>(x); // x >= 1: truncation is floor
+    }
+
     /// Whether corners p of cell (i, j, k) lie in its closed box; if so, sets `on` (see Placed).
     bool place_in_box(const std::array<Point3, 3>& p, std::int64_t i, std::int64_t j, std::int64_t k,
                       std::array<std::uint8_t, 3>& on) const
@@ -284,7 +302,7 @@ private:
             const auto at = static_cast<std::size_t>(cell[a]);
             if (at + 1 >= planes_[a].size()) return false;
             const double low = static_cast<double>(planes_[a][at]), high = static_cast<double>(planes_[a][at + 1]);
-            const double lo = std::fmin(low, high), hi = std::fmax(low, high);
+            const double lo = low < high ? low : high, hi = low < high ? high : low; // both finite
             for (std::size_t v = 0; v < 3; ++v) {
                 const double x = p[v][a];
                 if (!(x >= lo && x <= hi)) return false;
@@ -314,8 +332,7 @@ private:
                 cx += q[v][0];
                 cy += q[v][1];
             }
-            const auto ci = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(std::fmax(cx / 3, -1.0))), 0, cells_x_ - 1);
-            const auto cj = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(std::fmax(cy / 3, -1.0))), 0, cells_y_ - 1);
+            const std::int64_t ci = cell_at(cx / 3, cells_x_), cj = cell_at(cy / 3, cells_y_);
             const double lo[3] = {static_cast<double>(ci) - kCellMargin, static_cast<double>(cj) - kCellMargin, kz - kCellMargin};
             bool inside = true;
             for (int v = 0; v < 3; ++v)
@@ -408,7 +425,7 @@ private:
 
     /// Tests the pair (a, b) of different triangles; counts what it finds into `out` (coincident
     /// corners too, unless the caller has).
-    void test_pair(const Placed& a, const Placed& b, GridGeometry& out, bool count_coincident = true) const
+    CMC33_NOINLINE void test_pair(const Placed& a, const Placed& b, GridGeometry& out, bool count_coincident = true) const
     {
         if (!boxes_meet(a.box, b.box)) return;
         const std::uint32_t* a_ids = corners(a.triangle);
