@@ -236,6 +236,66 @@ TEST(SeamTopology, BrokenMeshesGiveMeshTopologyToo)
     }
 }
 
+/// `triangles` over vertices [0, nv) as slabs cut at `cuts`, each triangle in the slab of its
+/// smallest id (the cuts must leave its other ids in that slab or the next).
+std::vector<Slab> cut_into_slabs(const std::vector<std::uint32_t>& triangles, std::uint32_t nv,
+                                 const std::vector<std::uint32_t>& cuts)
+{
+    std::vector<std::uint32_t> b{0};
+    b.insert(b.end(), cuts.begin(), cuts.end());
+    b.push_back(nv);
+    std::vector<Slab> slabs;
+    for (std::size_t s = 0; s + 1 < b.size(); ++s) slabs.push_back(Slab{b[s], b[s + 1] - b[s], 0, 0, {}});
+    for (std::size_t t = 0; t < triangles.size(); t += 3) {
+        const std::uint32_t low = std::min({triangles[t], triangles[t + 1], triangles[t + 2]});
+        std::size_t s = 0;
+        while (s + 1 < slabs.size() && low >= b[s + 1]) ++s;
+        slabs[s].triangles.insert(slabs[s].triangles.end(), &triangles[t], &triangles[t] + 3);
+    }
+    return slabs;
+}
+
+// Most vertices are settled without sorting their ring (every edge used twice, once each way; at
+// most 16 triangles): a vertex where two closed fans meet, a fan of more triangles, and a flipped
+// triangle, which such a vertex has not, must count as mesh_topology() counts them.
+TEST(SeamTopology, RingsOfManyOrPinchedOrFlippedFansGiveMeshTopology)
+{
+    // two tetrahedra sharing vertex 0: every edge used twice, two fans at vertex 0
+    std::vector<std::uint32_t> pinched{0, 1, 2, 0, 2, 3, 0, 3, 1, 1, 3, 2, 0, 4, 5, 0, 5, 6, 0, 6, 4, 4, 6, 5};
+    // a bipyramid over a 20-gon (vertices 0..19, apexes 20 and 21): 20 triangles at each apex
+    std::vector<std::uint32_t> bipyramid;
+    for (std::uint32_t i = 0; i < 20; ++i) {
+        const std::uint32_t j = (i + 1) % 20;
+        bipyramid.insert(bipyramid.end(), {20, i, j, 21, j, i});
+    }
+    const auto flipped = [](std::vector<std::uint32_t> t, std::size_t which) {
+        std::swap(t[3 * which + 1], t[3 * which + 2]);
+        return t;
+    };
+    using Cuts = std::vector<std::vector<std::uint32_t>>;
+    const Cuts pinched_cuts{{}, {1}, {3}, {4}}, bipyramid_cuts{{}, {10}, {19}, {20}};
+    const struct {
+        std::vector<std::uint32_t> triangles;
+        std::uint32_t nv;
+        const Cuts& cuts;
+        const char* what;
+    } cases[] = {{pinched, 7, pinched_cuts, "pinched"},
+                 {flipped(pinched, 5), 7, pinched_cuts, "pinched, one triangle flipped"},
+                 {bipyramid, 22, bipyramid_cuts, "bipyramid"},
+                 {flipped(bipyramid, 7), 22, bipyramid_cuts, "bipyramid, one triangle flipped"}};
+    for (const auto& c : cases) {
+        for (const std::vector<std::uint32_t>& cuts : c.cuts) {
+            std::string w = std::string(c.what) + ", cut at";
+            for (const std::uint32_t x : cuts) w += " " + std::to_string(x);
+            check_all_groupings(cut_into_slabs(c.triangles, c.nv, cuts), w);
+        }
+    }
+    const MeshTopology t = SeamTopology::of_slab(SlabTriangles{0, 7, pinched, {}}).finish();
+    EXPECT_EQ(t.nonmanifold_vertices, 1);
+    EXPECT_EQ(t.nonmanifold_edges, 0);
+    EXPECT_TRUE(t.oriented);
+}
+
 TEST(SeamTopology, SharedVolumesInSlabs)
 {
     for (const char* name : {"neghip_66x66x66_uint8.nrrd", "HeadMRVolume_48x62x42_uint8.nrrd"}) {
