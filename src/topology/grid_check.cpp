@@ -351,7 +351,12 @@ private:
                 }
                 if (!proper) ++out.zero_area_triangles;
             }
-            Placed e{cj * cells_x_ + ci, t, {}, proper};
+            // written in place: a copy built on the stack field by field and then stored whole
+            // stalls on every triangle (its wide loads wait for the narrow stores)
+            Placed& e = layer.placed.emplace_back();
+            e.cell = cj * cells_x_ + ci;
+            e.triangle = t;
+            e.proper = proper;
             if (axis_aligned_) e.boxed = place_in_box(p, ci, cj, m_.k0 + z, e.on);
             if (e.boxed) e.touches = kContactsOf[e.on[0]] | kContactsOf[e.on[1]] | kContactsOf[e.on[2]];
             for (std::size_t a = 0; a < 3; ++a) {
@@ -359,7 +364,6 @@ private:
                 e.box.lo[a] = static_cast<float>(std::min({p[0][a], p[1][a], p[2][a]}));
                 e.box.hi[a] = static_cast<float>(std::max({p[0][a], p[1][a], p[2][a]}));
             }
-            layer.placed.push_back(e);
         }
         // extract() writes triangles cell by cell: nearly sorted already
         if (!std::is_sorted(layer.placed.begin(), layer.placed.end())) std::sort(layer.placed.begin(), layer.placed.end());
