@@ -26,6 +26,7 @@ struct SimplifyArgs {
     std::optional<double> ratio;
     std::optional<std::int64_t> triangles;
     std::optional<double> max_error;
+    std::optional<double> max_distance;
     int smooth = 0;
     bool largest = false;
     std::int64_t min_size = 0;
@@ -96,6 +97,7 @@ void run_simplify(const SimplifyArgs& args)
         if (args.ratio) o.ratio = *args.ratio;
         if (args.triangles) o.target_triangles = std::max<std::int64_t>(1, *args.triangles);
         if (args.max_error) o.max_error = *args.max_error;
+        if (args.max_distance) o.max_distance = *args.max_distance;
         const auto t0 = std::chrono::steady_clock::now();
         out = with_progress(args, "simplifying", [&](const Progress& p) {
             o.progress = p;
@@ -148,7 +150,8 @@ void run_simplify(const SimplifyArgs& args)
                {"smooth_seconds", smooth_seconds},
                {"collapses", sstats.collapses},
                {"refused", {{"topology", sstats.refused_topology}, {"flip", sstats.refused_flip},
-                            {"intersection", sstats.refused_intersection}}},
+                            {"intersection", sstats.refused_intersection},
+                            {"distance", sstats.refused_distance}}},
                {"max_quadric_error", sstats.max_quadric_error},
                {"smooth", {{"iterations", args.smooth}, {"moves", mstats.moves}, {"shortened", mstats.shortened},
                            {"undone", mstats.undone}}},
@@ -193,6 +196,11 @@ void add_simplify(CLI::App& app)
                     "Stop before a collapse whose quadric error exceeds E (world units: the root of the sum of "
                     "squared distances of the new vertex to the input planes merged into it)")
         ->type_name("E")
+        ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
+    cmd->add_option("--max-distance", args->max_distance,
+                    "Refuse a collapse that leaves an input vertex merged into it farther than D from its "
+                    "triangles (world units): bounds how far the input's vertices drift")
+        ->type_name("D")
         ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--smooth", args->smooth, "Taubin lambda|mu smoothing, N iterations, after simplifying")
         ->type_name("N")

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <queue>
 #include <string>
 
@@ -34,6 +35,7 @@ namespace {
 using mesh_ops::Pos;
 using mesh_ops::Refusal;
 using mesh_ops::Tri;
+using mesh_ops::V3;
 using mesh_ops::WorkMesh;
 
 /// Symmetric 4x4 form: a00 a01 a02 a03 a11 a12 a13 a22 a23 a33.
@@ -137,9 +139,36 @@ struct Simplifier {
     std::vector<std::uint32_t> version;
     std::priority_queue<Candidate> heap;
     SimplifyStats stats;
+    /// With a distance bound: the input's vertices, and per vertex the input vertices merged into it
+    /// (a list through cluster_next from the vertex itself to cluster_tail, kNone-terminated).
+    double max_distance_sq = std::numeric_limits<double>::infinity();
+    std::vector<V3> input;
+    std::vector<Tri> input_tri;
+    std::vector<std::uint32_t> input_star_first, input_star; ///< per input vertex its input triangles
+    std::vector<std::uint32_t> cluster_next, cluster_tail;
+    static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
-    explicit Simplifier(const Mesh& mesh) : m(mesh), quadric(m.pos.size()), version(m.pos.size(), 0)
+    Simplifier(const Mesh& mesh, double max_distance) : m(mesh), quadric(m.pos.size()), version(m.pos.size(), 0)
     {
+        if (std::isfinite(max_distance)) {
+            max_distance_sq = max_distance * max_distance;
+            input.reserve(m.pos.size());
+            cluster_tail.reserve(m.pos.size());
+            for (std::size_t v = 0; v < m.pos.size(); ++v) {
+                input.push_back(point(m.pos[v]));
+                cluster_tail.push_back(static_cast<std::uint32_t>(v));
+            }
+            cluster_next.assign(m.pos.size(), kNone);
+            input_tri = m.tri;
+            input_star_first.assign(m.pos.size() + 1, 0);
+            for (const Tri& t : input_tri)
+                for (const std::uint32_t v : t) ++input_star_first[v + 1];
+            for (std::size_t v = 0; v < m.pos.size(); ++v) input_star_first[v + 1] += input_star_first[v];
+            input_star.resize(input_star_first.back());
+            std::vector<std::uint32_t> fill(input_star_first.begin(), input_star_first.end() - 1);
+            for (std::size_t t = 0; t < input_tri.size(); ++t)
+                for (const std::uint32_t v : input_tri[t]) input_star[fill[v]++] = static_cast<std::uint32_t>(t);
+        }
         for (std::size_t t = 0; t < m.tri.size(); ++t) {
             const Tri& c = m.tri[t];
             const Pos& a = m.pos[c[0]];
@@ -280,6 +309,59 @@ struct Simplifier {
         return false;
     }
 
+    static V3 point(const Pos& p)
+    {
+        return {static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2])};
+    }
+
+    /// Whether x lies within the bound of the input triangles at the input vertices merged into a or b.
+    bool near_input(const V3& x, std::uint32_t a, std::uint32_t b) const
+    {
+        for (const std::uint32_t start : {a, b}) {
+            for (std::uint32_t q = start; q != kNone; q = cluster_next[q]) {
+                for (std::uint32_t i = input_star_first[q]; i < input_star_first[q + 1]; ++i) {
+                    const Tri& t = input_tri[input_star[i]];
+                    if (mesh_ops::point_triangle_sq(x, input[t[0]], input[t[1]], input[t[2]]) <= max_distance_sq) return true;
+                }
+            }
+        }
+        return false;
+    }
+
+    /// Whether the triangles `new_tris_` would make (a at p) stay within the bound of the input
+    /// both ways, as far as the input vertices merged into a or b tell: each of those vertices near
+    /// the new triangles, and the new vertex and the new triangles' centroids near their input
+    /// triangles.
+    bool within_bound(std::uint32_t a, std::uint32_t b, const Pos& p) const
+    {
+        if (!std::isfinite(max_distance_sq)) return true;
+        const auto at = [&](std::uint32_t v) { return v == a ? point(p) : point(m.pos[v]); };
+        if (!near_input(point(p), a, b)) return false;
+        const V3 c = point(p);
+        for (const Tri& t : new_tris_) {
+            const V3 x = at(t[0]), y = at(t[1]), z = at(t[2]);
+            if (!near_input({(x[0] + y[0] + z[0]) / 3, (x[1] + y[1] + z[1]) / 3, (x[2] + y[2] + z[2]) / 3}, a, b)) return false;
+            // the midpoints of its edges at the new vertex (the third edge is an old one)
+            for (const V3& w : {x, y, z}) {
+                if (w == c) continue;
+                if (!near_input({(w[0] + c[0]) / 2, (w[1] + c[1]) / 2, (w[2] + c[2]) / 2}, a, b)) return false;
+            }
+        }
+        for (const std::uint32_t start : {a, b}) {
+            for (std::uint32_t q = start; q != kNone; q = cluster_next[q]) {
+                bool near = false;
+                for (const Tri& t : new_tris_) {
+                    if (mesh_ops::point_triangle_sq(input[q], at(t[0]), at(t[1]), at(t[2])) <= max_distance_sq) {
+                        near = true;
+                        break;
+                    }
+                }
+                if (!near) return false;
+            }
+        }
+        return true;
+    }
+
     std::vector<std::uint32_t> na_, nb_, common_, shared_, changed_;
     std::vector<Tri> new_tris_;
 
@@ -338,6 +420,10 @@ struct Simplifier {
         if (r == Refusal::flip) ++stats.refused_flip;
         if (r == Refusal::intersection) ++stats.refused_intersection;
         if (r != Refusal::none) return false;
+        if (!within_bound(a, b, p)) {
+            ++stats.refused_distance;
+            return false;
+        }
         // apply
         for (const std::uint32_t t : shared_) {
             m.grid.remove(t);
@@ -358,6 +444,10 @@ struct Simplifier {
             m.grid.insert(changed_[i], m.corners(changed_[i]));
         }
         quadric[a] += quadric[b];
+        if (!cluster_next.empty()) {
+            cluster_next[cluster_tail[a]] = b;
+            cluster_tail[a] = cluster_tail[b];
+        }
         ++version[a];
         ++version[b];
         ++stats.collapses;
@@ -376,7 +466,10 @@ Mesh simplify(const Mesh& mesh, const SimplifyOptions& options, SimplifyStats* s
     if (std::isnan(options.max_error) || options.max_error < 0) {
         throw Error(Status::invalid_argument, "simplify: max error must be >= 0");
     }
-    Simplifier s(mesh);
+    if (std::isnan(options.max_distance) || options.max_distance < 0) {
+        throw Error(Status::invalid_argument, "simplify: max distance must be >= 0");
+    }
+    Simplifier s(mesh, options.max_distance);
     const std::int64_t start = s.m.alive_count;
     // no count target (ratio 1): the error bound alone stops it; with neither, nothing is done
     std::int64_t target = options.target_triangles > 0 ? options.target_triangles

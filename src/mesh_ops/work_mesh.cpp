@@ -392,4 +392,38 @@ void compute_normals(Mesh& mesh)
     }
 }
 
+// Squared distance from p to the closed triangle abc, by the region of the triangle's plane p
+/// projects to (a corner, an edge or the inside), from the barycentric signs.
+double point_triangle_sq(const V3& p, const V3& a, const V3& b, const V3& c)
+{
+    const V3 ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+    const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+    auto sq = [&](const V3& q) { const V3 d = sub(p, q); return dot(d, d); };
+    if (d1 <= 0 && d2 <= 0) return sq(a);
+    const V3 bp = sub(p, b);
+    const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+    if (d3 >= 0 && d4 <= d3) return sq(b);
+    const double vc = d1 * d4 - d3 * d2;
+    if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+        const double v = d1 / (d1 - d3);
+        return sq({a[0] + v * ab[0], a[1] + v * ab[1], a[2] + v * ab[2]});
+    }
+    const V3 cp = sub(p, c);
+    const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+    if (d6 >= 0 && d5 <= d6) return sq(c);
+    const double vb = d5 * d2 - d1 * d6;
+    if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+        const double w = d2 / (d2 - d6);
+        return sq({a[0] + w * ac[0], a[1] + w * ac[1], a[2] + w * ac[2]});
+    }
+    const double va = d3 * d6 - d5 * d4;
+    if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+        const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return sq({b[0] + w * (c[0] - b[0]), b[1] + w * (c[1] - b[1]), b[2] + w * (c[2] - b[2])});
+    }
+    const double denom = 1 / (va + vb + vc);
+    const double v = vb * denom, w = vc * denom;
+    return sq({a[0] + ab[0] * v + ac[0] * w, a[1] + ab[1] * v + ac[1] * w, a[2] + ab[2] * v + ac[2] * w});
+}
+
 } // namespace cmc33::mesh_ops

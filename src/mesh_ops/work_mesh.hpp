@@ -15,6 +15,13 @@ namespace cmc33::mesh_ops {
 
 using Pos = std::array<float, 3>;
 using Tri = std::array<std::uint32_t, 3>;
+using V3 = std::array<double, 3>;
+
+inline V3 sub(const V3& a, const V3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+inline double dot(const V3& a, const V3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/// Squared distance from p to the closed triangle abc (Hausdorff samples, simplify's distance bound).
+double point_triangle_sq(const V3& p, const V3& a, const V3& b, const V3& c);
 
 /// Triangles by the grid cells their boxes overlap. Positions outside the grid's box clamp to its
 /// border cells, so a moved vertex never falls out of it.

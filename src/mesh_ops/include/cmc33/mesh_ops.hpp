@@ -23,6 +23,10 @@ struct SimplifyOptions {
     /// Stop before a collapse whose quadric error (the sum of squared distances of the new vertex
     /// to the planes of the input triangles merged into it) exceeds max_error squared, world units.
     double max_error = std::numeric_limits<double>::infinity();
+    /// Refuse a collapse that would leave an input vertex merged into the new vertex farther than
+    /// this from the new vertex's triangles (world units): a bound on how far the input's vertices
+    /// drift from the output (infinity: none).
+    double max_distance = std::numeric_limits<double>::infinity();
     /// Optional: called with the fraction done; false stops (Error{cancelled}).
     std::function<bool(double fraction)> progress;
 };
@@ -32,6 +36,7 @@ struct SimplifyStats {
     std::int64_t refused_topology = 0;   ///< refused by the link condition or a locked vertex
     std::int64_t refused_flip = 0;       ///< refused: a triangle would turn by more than 90 degrees or vanish
     std::int64_t refused_intersection = 0; ///< refused: a new triangle would meet another improperly
+    std::int64_t refused_distance = 0;   ///< refused: an input vertex would end farther than max_distance
     double max_quadric_error = 0;        ///< the largest quadric error of a collapse done (world units, square-rooted)
 };
 
