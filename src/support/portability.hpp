@@ -36,8 +36,10 @@
 
 #if defined(__GNUC__) || defined(__clang__)
 #define CMC33_ALWAYS_INLINE [[gnu::always_inline]] inline
+#define CMC33_NOINLINE [[gnu::noinline]]
 #else
 #define CMC33_ALWAYS_INLINE inline
+#define CMC33_NOINLINE
 #endif
 
 /// A hint to fetch the cache line at address p (read); nothing where the compiler has no such hint.

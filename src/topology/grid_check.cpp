@@ -29,15 +29,7 @@
 
 #include "cmc33/error.hpp"
 #include "exact_geometry.hpp"
-
-// test_pair() is the rare path of the pair walk: kept out of its callers, their loops stay small
-#if defined(__GNUC__) || defined(__clang__)
-#define CMC33_NOINLINE [[gnu::noinline]]
-#elif defined(_MSC_VER)
-#define CMC33_NOINLINE __declspec(noinline)
-#else
-#define CMC33_NOINLINE
-#endif
+#include "portability.hpp"
 
 namespace cmc33::detail {
 namespace {
@@ -428,7 +420,8 @@ private:
     }
 
     /// Tests the pair (a, b) of different triangles; counts what it finds into `out` (coincident
-    /// corners too, unless the caller has).
+    /// corners too, unless the caller has). The rare path of the pair walk: not inlined, so that
+    /// the walk's loops stay small.
     CMC33_NOINLINE void test_pair(const Placed& a, const Placed& b, GridGeometry& out, bool count_coincident = true) const
     {
         if (!boxes_meet(a.box, b.box)) return;
