@@ -10,6 +10,7 @@
 #include "cmc33/verify.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "dataset.hpp"
 #include "plural.hpp"
 
 namespace cmc33::cli {

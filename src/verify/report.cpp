@@ -1,4 +1,4 @@
-// Tallies, failure records and failures.tsv: what verify() and verify_dataset() share.
+// Tallies, failure records and failures.tsv: what verify() and the CLI's dataset check share.
 
 #include <algorithm>
 #include <array>
@@ -190,8 +190,8 @@ std::vector<Tally> merge(std::vector<std::vector<Tally>>& per_thread, int max_fa
     return total;
 }
 
-void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir,
-            const std::string& command_template, VerifyReport& report)
+void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir, const RerunCommand& rerun_external,
+            VerifyReport& report)
 {
     bool any = false;
     for (Tally& t : tallies) {
@@ -224,7 +224,7 @@ void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir,
                 const std::filesystem::path mesh_base = dir / (f.name + "-" + method);
                 std::string command, cell_line = "-";
                 if (tally.report.external) {
-                    command = expand_command(command_template, volume_path, f.iso, mesh_base).shell;
+                    command = rerun_external ? rerun_external(volume_path, f.iso, mesh_base) : "";
                 } else {
                     command = "cmc33 extract " + shell_quote(volume_path.string()) + " --iso " +
                               number_text(f.iso) + " --method " + method + " --json";

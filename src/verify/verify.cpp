@@ -149,7 +149,7 @@ VerifyReport verify(const VerifyOptions& options)
     }
     std::vector<Tally> merged = verification::detail::merge(tallies, options.max_failures);
     report.seconds = tick.seconds();
-    verification::detail::finish(merged, options.failures_dir, "", report);
+    verification::detail::finish(merged, options.failures_dir, {}, report);
     tick(0);
     return report;
 }

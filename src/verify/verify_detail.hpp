@@ -1,6 +1,8 @@
 #pragma once
-// What verify() and verify_dataset() share: the parallel loop with its progress ticks, the
-// per-thread tallies, and the failure records written at the end.
+// What verify() and the CLI's dataset check (cli/dataset, `cmc33 verify --dataset`) share: the
+// parallel loop with its progress ticks, the per-thread tallies, and the failure records written
+// at the end. Not installed; the functions the CLI calls are exported (CMC33_VERIFY_EXPORT) so
+// that a shared library still offers them to it, as io's atomic_file.hpp does.
 
 #include <algorithm>
 #include <array>
@@ -10,6 +12,7 @@
 #include <cstdint>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -20,12 +23,13 @@
 #include "cmc33/mesh.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
+#include "cmc33/verify_export.hpp"
 #include "cmc33/volume.hpp"
 
 namespace cmc33::verification::detail {
 
 /// Subcases whose tiling depends on a face or interior test: the names with a dot (3.1 ... 13.5.2).
-bool is_ambiguous_subcase(int subcase) noexcept;
+CMC33_VERIFY_EXPORT bool is_ambiguous_subcase(int subcase) noexcept;
 
 /// One mismatching (field, method) pair, kept until the end of the run.
 struct Failure {
@@ -62,14 +66,14 @@ struct Outcome {
 
 /// Adds the comparison to `tally` and, on a mismatch, keeps the failure if it may be among the
 /// first max_failures. Returns true if the mesh matched.
-bool record(Tally& tally, Outcome&& outcome, int max_failures);
+CMC33_VERIFY_EXPORT bool record(Tally& tally, Outcome&& outcome, int max_failures);
 
 /// @throws Error{invalid_argument} if `methods` is empty or lists a method twice.
-void check_methods(const std::vector<Method>& methods);
+CMC33_VERIFY_EXPORT void check_methods(const std::vector<Method>& methods);
 
 /// One tally per method per thread: methods[m] named, or one "command" tally if `external`.
-std::vector<std::vector<Tally>> make_tallies(int threads, const std::vector<Method>& methods,
-                                             bool external);
+CMC33_VERIFY_EXPORT std::vector<std::vector<Tally>> make_tallies(int threads, const std::vector<Method>& methods,
+                                                                 bool external);
 
 /// Reports progress over passes that each count from 0: passes its callback the done count plus
 /// the fields of the finished passes.
@@ -107,13 +111,18 @@ private:
 };
 
 /// Sums the per-thread tallies of each method, in thread order (totals do not depend on it).
-std::vector<Tally> merge(std::vector<std::vector<Tally>>& per_thread, int max_failures);
+CMC33_VERIFY_EXPORT std::vector<Tally> merge(std::vector<std::vector<Tally>>& per_thread, int max_failures);
+
+/// The shell line that reruns an external command on a saved failing field: `in` the saved
+/// volume, `out_base` the saved mesh's path without extension.
+using RerunCommand =
+    std::function<std::string(const std::filesystem::path& in, double iso, const std::filesystem::path& out_base)>;
 
 /// Writes the failures of every method to `dir` (created if there is one) and moves the tallies'
-/// reports into report.methods, with their failures_written counts. `command_template` is the
-/// external command, if any, for the line that reproduces its failures.
-void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir,
-            const std::string& command_template, VerifyReport& report);
+/// reports into report.methods, with their failures_written counts. `rerun_external` gives the
+/// line that reproduces a failure of the external tally, if there is one.
+CMC33_VERIFY_EXPORT void finish(std::vector<Tally>& tallies, const std::filesystem::path& dir,
+                                const RerunCommand& rerun_external, VerifyReport& report);
 
 /// Runs body(thread, begin, end) over [0, total) in batches that `threads` workers pull from a
 /// shared counter, and calls tick(done) on the calling thread about every 0.2 s while they run.
@@ -171,9 +180,9 @@ void run_parallel(std::int64_t total, int threads, std::int64_t batch, Tick&& ti
 }
 
 /// Single-quoted for a POSIX shell.
-std::string shell_quote(const std::string& text);
+CMC33_VERIFY_EXPORT std::string shell_quote(const std::string& text);
 
 /// The value as the shortest decimal text that reads back as the same double.
-std::string number_text(double value);
+CMC33_VERIFY_EXPORT std::string number_text(double value);
 
 } // namespace cmc33::verification::detail

@@ -1,7 +1,8 @@
 // The public verification dataset (the paper's Sec. 4.1 offers the same: "Marching Cubes cases
 // grids and randomly generated 5x5x5 grids" with their invariants): the fields of verify() as
 // NRRD files, a manifest of their expected invariants, and verify_dataset() to judge any
-// extractor against it, in-process or as an external command.
+// extractor against it, in-process or as an external command. The comparison and the report are
+// the library's verification bookkeeping (src/verify/verify_detail.hpp).
 
 #include <algorithm>
 #include <array>
@@ -32,11 +33,12 @@
 #include "cmc33/io.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
-#include "parallel.hpp"
 #include "atomic_file.hpp"
+#include "dataset.hpp"
+#include "parallel.hpp"
 #include "verify_detail.hpp"
 
-namespace cmc33 {
+namespace cmc33::cli {
 namespace {
 
 using verification::detail::number_text;
@@ -522,7 +524,7 @@ DatasetSummary write_dataset(const std::filesystem::path& dir, const DatasetOpti
         }
     }
     const std::int64_t total = options.cells + options.grids + options.closed + options.ties;
-    const int threads = detail::threads_for(options.threads, total);
+    const int threads = cmc33::detail::threads_for(options.threads, total);
     verification::detail::Ticker tick(options.progress, total, nullptr);
 
     DatasetSummary summary;
@@ -714,7 +716,7 @@ VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerif
         verification::detail::check_methods(options.methods);
     }
     const auto total = static_cast<std::int64_t>(entries.size());
-    const int threads = detail::threads_for(options.threads, total);
+    const int threads = cmc33::detail::threads_for(options.threads, total);
     std::vector<std::vector<Tally>> tallies =
         verification::detail::make_tallies(threads, options.methods, external);
     std::atomic<std::int64_t> mismatched{0};
@@ -752,9 +754,15 @@ VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerif
     }
     std::vector<Tally> merged = verification::detail::merge(tallies, options.max_failures);
     report.seconds = tick.seconds();
-    verification::detail::finish(merged, options.failures_dir, options.command, report);
+    verification::detail::RerunCommand rerun;
+    if (external) {
+        rerun = [&options](const std::filesystem::path& in, double iso, const std::filesystem::path& out_base) {
+            return expand_command(options.command, in, iso, out_base).shell;
+        };
+    }
+    verification::detail::finish(merged, options.failures_dir, rerun, report);
     tick(0);
     return report;
 }
 
-} // namespace cmc33
+} // namespace cmc33::cli
