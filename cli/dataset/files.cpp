@@ -1,50 +1,60 @@
-// The public verification dataset (the paper's Sec. 4.1 offers the same: "Marching Cubes cases
+// The verification dataset's folder (the paper's Sec. 4.1 offers the same: "Marching Cubes cases
 // grids and randomly generated 5x5x5 grids" with their invariants): the fields of verify() as
-// NRRD files, a manifest of their expected invariants, and verify_dataset() to judge any
-// extractor against it, in-process or as an external command. The comparison and the report are
-// the library's verification bookkeeping (src/verify/verify_detail.hpp).
+// NRRD files, a README, and manifest.tsv with their expected invariants; written by
+// write_dataset (into a hidden folder, moved into place at the end) and read by read_manifest.
 
 #include <algorithm>
 #include <array>
-#include <atomic>
-#include <cctype>
 #include <charconv>
-#include <chrono>
-#include <cerrno>
 #include <cmath>
-#include <csignal>
-#include <cstdlib>
 #include <fstream>
-#include <memory>
 #include <optional>
-#include <utility>
 #include <string>
+#include <string_view>
 #include <system_error>
-#include <thread>
+#include <utility>
 #include <vector>
 
-#include <pthread.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "cmc33/cell.hpp"
 #include "cmc33/error.hpp"
-#include "cmc33/extract.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/topology.hpp"
 #include "cmc33/verify.hpp"
 #include "atomic_file.hpp"
 #include "dataset.hpp"
+#include "dataset_detail.hpp"
 #include "parallel.hpp"
 #include "verify_detail.hpp"
 
 namespace cmc33::cli {
+
+namespace dataset_detail {
+
+std::string clip(std::string text, std::size_t max_chars)
+{
+    if (text.size() > max_chars) text = text.substr(0, max_chars) + "...";
+    return text;
+}
+
+std::array<double, 8> corner_values(const Volume& volume)
+{
+    std::array<double, 8> v{};
+    volume.visit([&](auto view) {
+        for (int c = 0; c < 8; ++c)
+            v[static_cast<std::size_t>(c)] =
+                static_cast<double>(view(c & 1, c >> 1 & 1, c >> 2 & 1));
+    });
+    return v;
+}
+
+} // namespace dataset_detail
+
 namespace {
 
-using verification::detail::number_text;
-using verification::detail::Outcome;
-using verification::detail::shell_quote;
-using verification::detail::Tally;
+using dataset_detail::clip;
+using dataset_detail::corner_values;
 
 constexpr std::string_view kManifestHeader =
     "file\tiso\teuler\tb0\tb1\tb2\tboundary_loops\tsubcase";
@@ -149,54 +159,6 @@ void write_text(const std::filesystem::path& path, const std::string& text)
                     path.string() + ": cannot rename " + tmp.string() + " to it: " + ec.message());
 }
 
-std::array<double, 8> corner_values(const Volume& volume)
-{
-    std::array<double, 8> v{};
-    volume.visit([&](auto view) {
-        for (int c = 0; c < 8; ++c)
-            v[static_cast<std::size_t>(c)] =
-                static_cast<double>(view(c & 1, c >> 1 & 1, c >> 2 & 1));
-    });
-    return v;
-}
-
-bool is_cell(const Volume& volume)
-{
-    return volume.dims() == Index3{2, 2, 2};
-}
-
-/// The subcases a field counts for under `method` (see MethodReport).
-std::vector<int> subcases_of(const Volume& volume, double iso, Method method,
-                             const ExtractStats* stats)
-{
-    std::vector<int> out;
-    if (is_cell(volume)) {
-        out.push_back(analyze_cell(corner_values(volume), iso, method).subcase);
-        return out;
-    }
-    ExtractStats own;
-    if (stats == nullptr) {
-        ExtractOptions o;
-        o.method = method;
-        o.threads = 1;
-        extract(volume, iso, o, &own);
-        stats = &own;
-    }
-    for (int s = 0; s < kSubcaseCount; ++s) {
-        if (stats->cells_per_subcase[static_cast<std::size_t>(s)] > 0 &&
-            verification::detail::is_ambiguous_subcase(s)) {
-            out.push_back(s);
-        }
-    }
-    return out;
-}
-
-std::string clip(std::string text, std::size_t max_chars = 60)
-{
-    if (text.size() > max_chars) text = text.substr(0, max_chars) + "...";
-    return text;
-}
-
 /// Splits a manifest line at tabs.
 std::vector<std::string_view> split_tabs(std::string_view line)
 {
@@ -218,188 +180,6 @@ int subcase_index(std::string_view name)
         if (subcase_name(s) == name) return s;
     }
     return -1;
-}
-
-/// The temporary folder of the external command's outputs, registered so that a signal removes
-/// it too (io/atomic_file.hpp); the destructor removes it.
-struct TempFolder {
-    std::filesystem::path path;
-    io::detail::Temporary temp;
-    TempFolder() : path(fresh_path()), temp(path, [this] { create(); }) {}
-
-private:
-    static std::filesystem::path fresh_path()
-    {
-        const auto stamp = std::chrono::steady_clock::now().time_since_epoch().count();
-        return std::filesystem::temp_directory_path() /
-               ("cmc33-verify-" + std::to_string(::getpid()) + "-" + std::to_string(stamp));
-    }
-    void create() const
-    {
-        std::error_code ec;
-        std::filesystem::create_directories(path, ec);
-        if (ec)
-            throw Error(Status::io_error,
-                        path.string() + ": cannot create a temporary folder: " + ec.message());
-    }
-};
-
-std::string last_line(const std::filesystem::path& log)
-{
-    std::ifstream in(log, std::ios::binary);
-    std::string line, last;
-    while (std::getline(in, line)) {
-        if (!line.empty() && line.back() == '\r') line.pop_back();
-        if (line.find_first_not_of(" \t") != std::string::npos) last = line;
-    }
-    return clip(last, 300);
-}
-
-struct CommandResult {
-    std::optional<Mesh> mesh;
-    std::string note; ///< why there is no mesh
-};
-
-/// Runs the shell line in its own process group, so that a timeout or a signal kills the whole
-/// tool (a shell may have started several processes). Returns the wait status, or -1 if it could
-/// not start; `timed_out` is set if it was killed after `timeout_seconds` (<= 0: no limit).
-int run_shell(const std::string& line, double timeout_seconds, bool& timed_out)
-{
-    timed_out = false;
-    const char* const argv[] = {"/bin/sh", "-c", line.c_str(), nullptr};
-    const pid_t pid = io::detail::start_child([&argv] {
-        // In the forked child: async-signal-safe calls only, then exec.
-        ::setpgid(0, 0);
-        sigset_t none;
-        sigemptyset(&none);
-        ::pthread_sigmask(SIG_SETMASK, &none, nullptr); // the CLI blocks SIGINT/SIGTERM/SIGHUP
-        ::execv(argv[0], const_cast<char* const*>(argv));
-    });
-    if (pid < 0) return -1;
-    const auto deadline = std::chrono::steady_clock::now() +
-                          std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                              std::chrono::duration<double>(timeout_seconds));
-    auto pause = std::chrono::microseconds(100); // most tools take milliseconds: poll often, then less
-    int status = 0;
-    for (;;) {
-        const pid_t r = ::waitpid(pid, &status, WNOHANG);
-        if (r == pid) break;
-        if (r < 0 && errno != EINTR) {
-            status = -1;
-            break;
-        }
-        if (timeout_seconds > 0 && std::chrono::steady_clock::now() >= deadline) {
-            ::kill(-pid, SIGKILL);
-            while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
-            }
-            timed_out = true;
-            break;
-        }
-        std::this_thread::sleep_for(pause);
-        pause = std::min<std::chrono::microseconds>(pause * 2, std::chrono::milliseconds(20));
-    }
-    io::detail::forget_child(pid);
-    return status;
-}
-
-CommandResult run_command(const ExternalCommand& command, const std::filesystem::path& log,
-                          double timeout_seconds)
-{
-    std::error_code ec;
-    std::filesystem::remove(command.output, ec);
-    // the newline ends a `#` comment the template may hold, which would otherwise swallow the ")"
-    const std::string line =
-        "(" + command.shell + "\n) >" + shell_quote(log.string()) + " 2>&1 </dev/null";
-    bool timed_out = false;
-    const int status = run_shell(line, timeout_seconds, timed_out);
-    CommandResult result;
-    if (status == -1) {
-        result.note = "could not start the command (fork or wait failed)";
-        return result;
-    }
-    if (timed_out) {
-        result.note = "the command did not finish within " + number_text(timeout_seconds) +
-                      " s (--timeout) and was killed";
-    } else if (WIFSIGNALED(status)) {
-        result.note = "the command was killed by signal " + std::to_string(WTERMSIG(status));
-    } else if (WIFEXITED(status) && WEXITSTATUS(status) != 0) {
-        result.note = "the command exited with status " + std::to_string(WEXITSTATUS(status));
-    } else if (!std::filesystem::exists(command.output)) {
-        result.note = "the command wrote no " + command.output.filename().string();
-    } else {
-        try {
-            result.mesh = io::read_mesh(command.output);
-        } catch (const Error& e) {
-            result.note = std::string("its mesh does not read: ") + e.what();
-        }
-    }
-    if (!result.mesh) {
-        const std::string said = last_line(log);
-        if (!said.empty()) result.note += "; it said: " + said;
-    }
-    std::filesystem::remove(command.output, ec);
-    return result;
-}
-
-/// Kind of a manifest entry: cell-* files and lines with a subcase are cells, closed-* files
-/// closed grids, anything else a grid.
-FieldKind kind_of(const ManifestEntry& entry)
-{
-    const std::string stem = std::filesystem::path(entry.file).filename().string();
-    if (stem.rfind("closed", 0) == 0) return FieldKind::closed;
-    if (stem.rfind("ties", 0) == 0) return FieldKind::ties;
-    if (entry.subcase != "-" || stem.rfind("cell", 0) == 0) return FieldKind::cell;
-    return FieldKind::grid;
-}
-
-struct EntryCheck {
-    const std::filesystem::path& dir;
-    const ManifestEntry& entry;
-    FieldKind kind;
-    std::int64_t order; ///< line index: failures are kept in manifest order
-};
-
-/// Checks one manifest entry with every method (or the command); `scratch` is this thread's
-/// prefix for the command's output and log files.
-void check_entry(const EntryCheck& check, const DatasetVerifyOptions& options,
-                 const std::filesystem::path& scratch, std::vector<Tally>& mine,
-                 std::atomic<std::int64_t>& mismatched)
-{
-    const ManifestEntry& entry = check.entry;
-    const std::filesystem::path path = check.dir / entry.file;
-    const auto volume = std::make_shared<const Volume>(io::read_volume(path));
-    for (Tally& tally : mine) {
-        Outcome outcome;
-        outcome.kind = check.kind;
-        outcome.order = check.order;
-        outcome.name = std::filesystem::path(entry.file).stem().string();
-        outcome.volume = volume;
-        outcome.iso = entry.iso;
-        outcome.expected = &entry.expected;
-        if (tally.report.external) {
-            const ExternalCommand command = expand_command(options.command, path, entry.iso,
-                                                           scratch.string() + "-" + outcome.name);
-            CommandResult result =
-                run_command(command, scratch.string() + "-log.txt", options.timeout_seconds);
-            outcome.mesh = std::move(result.mesh);
-            outcome.note = std::move(result.note);
-            outcome.subcases = subcases_of(*volume, entry.iso, Method::cmc33, nullptr);
-        } else {
-            ExtractOptions o;
-            o.method = tally.report.method;
-            o.threads = 1;
-            ExtractStats stats;
-            try {
-                outcome.mesh = extract(*volume, entry.iso, o, &stats);
-            } catch (const Error& e) {
-                outcome.note = std::string("extract failed: ") + e.what();
-            }
-            outcome.subcases = subcases_of(*volume, entry.iso, o.method, &stats);
-        }
-        if (!verification::detail::record(tally, std::move(outcome), options.max_failures)) {
-            mismatched.fetch_add(1, std::memory_order_relaxed);
-        }
-    }
 }
 
 /// Writes field n of `kind` into the dataset and returns its manifest line, or "" if its
@@ -653,116 +433,6 @@ std::vector<ManifestEntry> read_manifest(const std::filesystem::path& dir)
         throw Error(Status::bad_format,
                     path.string() + ": is empty; expected a header line and one line per file");
     return entries;
-}
-
-ExternalCommand expand_command(std::string_view command_template, const std::filesystem::path& in,
-                               double iso, const std::filesystem::path& out_base)
-{
-    const std::string_view kIn = "{in}", kIso = "{iso}", kOut = "{out}";
-    const std::size_t out_at = command_template.find(kOut);
-    for (const std::string_view needed : {kIn, kOut}) {
-        if (command_template.find(needed) == std::string_view::npos) {
-            throw Error(Status::invalid_argument,
-                        "command \"" + clip(std::string(command_template)) + "\" has no " +
-                            std::string(needed) + "; expected placeholders {in}, {iso} and {out}");
-        }
-    }
-    ExternalCommand command;
-    std::string out_text = out_base.string();
-    std::string extension = ".ply";
-    bool extension_given = false;
-    const std::string_view after = command_template.substr(out_at + kOut.size());
-    for (std::string_view ext : {".ply", ".obj", ".off", ".stl"}) {
-        if (after.size() >= ext.size() && after.substr(0, ext.size()) == ext &&
-            (after.size() == ext.size() ||
-             !std::isalnum(static_cast<unsigned char>(after[ext.size()])))) {
-            extension = std::string(ext);
-            extension_given = true;
-        }
-    }
-    command.output = out_text + extension;
-    const std::string out_quoted = shell_quote(extension_given ? out_text : out_text + extension);
-    const std::string in_quoted = shell_quote(in.string());
-    const std::string iso_text = number_text(iso);
-    for (std::size_t i = 0; i < command_template.size();) {
-        const std::string_view rest = command_template.substr(i);
-        if (rest.substr(0, kIn.size()) == kIn) {
-            command.shell += in_quoted;
-            i += kIn.size();
-        } else if (rest.substr(0, kIso.size()) == kIso) {
-            command.shell += iso_text;
-            i += kIso.size();
-        } else if (rest.substr(0, kOut.size()) == kOut) {
-            command.shell += out_quoted;
-            i += kOut.size();
-        } else {
-            command.shell += command_template[i++];
-        }
-    }
-    return command;
-}
-
-VerifyReport verify_dataset(const std::filesystem::path& dir, const DatasetVerifyOptions& options)
-{
-    const std::vector<ManifestEntry> entries = read_manifest(dir);
-    if (entries.empty()) {
-        throw Error(Status::bad_format, (dir / "manifest.tsv").string() +
-                                            ": lists no file; expected one line per file");
-    }
-    const bool external = !options.command.empty();
-    if (external) {
-        (void)expand_command(options.command, "in", 0.0, "out"); // throws without {in} or {out}
-    } else {
-        verification::detail::check_methods(options.methods);
-    }
-    const auto total = static_cast<std::int64_t>(entries.size());
-    const int threads = cmc33::detail::threads_for(options.threads, total);
-    std::vector<std::vector<Tally>> tallies =
-        verification::detail::make_tallies(threads, options.methods, external);
-    std::atomic<std::int64_t> mismatched{0};
-    verification::detail::Ticker tick(options.progress, total, &mismatched);
-    std::optional<TempFolder> temp;
-    if (external) temp.emplace();
-
-    // Each kind runs as one pass (in manifest order), so that its rate can be reported.
-    std::array<std::vector<std::size_t>, kFieldKindCount> by_kind;
-    for (std::size_t i = 0; i < entries.size(); ++i) {
-        by_kind[static_cast<std::size_t>(kind_of(entries[i]))].push_back(i);
-    }
-    VerifyReport report;
-    report.threads = threads;
-    for (int k = 0; k < kFieldKindCount; ++k) {
-        const std::vector<std::size_t>& items = by_kind[static_cast<std::size_t>(k)];
-        const double kind_start = tick.seconds();
-        const auto count = static_cast<std::int64_t>(items.size());
-        verification::detail::run_parallel(
-            count, threads, external ? 2 : 16, tick,
-            [&](int t, std::int64_t begin, std::int64_t end) {
-                for (std::int64_t i = begin; i < end; ++i) {
-                    const std::size_t item = items[static_cast<std::size_t>(i)];
-                    const EntryCheck check{dir, entries[item], static_cast<FieldKind>(k),
-                                           static_cast<std::int64_t>(item)};
-                    const std::filesystem::path scratch =
-                        external ? temp->path / ("t" + std::to_string(t)) : std::filesystem::path();
-                    check_entry(check, options, scratch, tallies[static_cast<std::size_t>(t)],
-                                mismatched);
-                }
-            });
-        report.fields[static_cast<std::size_t>(k)] = count;
-        report.kind_seconds[static_cast<std::size_t>(k)] = tick.seconds() - kind_start;
-        tick.pass_done(count);
-    }
-    std::vector<Tally> merged = verification::detail::merge(tallies, options.max_failures);
-    report.seconds = tick.seconds();
-    verification::detail::RerunCommand rerun;
-    if (external) {
-        rerun = [&options](const std::filesystem::path& in, double iso, const std::filesystem::path& out_base) {
-            return expand_command(options.command, in, iso, out_base).shell;
-        };
-    }
-    verification::detail::finish(merged, options.failures_dir, rerun, report);
-    tick(0);
-    return report;
 }
 
 } // namespace cmc33::cli
