@@ -21,6 +21,7 @@
 #include <utility>
 
 #include "cmc33/io.hpp"
+#include "cmc33/io_export.hpp" // the CLI opens its inputs with InputFile across the library boundary
 
 struct z_stream_s; // zlib's z_stream
 
@@ -29,7 +30,7 @@ namespace cmc33::io::detail {
 class PortableInflater; // inflate_portable.hpp: InflateStream's engine in builds without zlib
 
 /// Bytes that can be read by (offset, count). The size is fixed when the input is opened.
-class ByteInput {
+class CMC33_IO_EXPORT ByteInput {
 public:
     virtual ~ByteInput() = default;
     ByteInput(const ByteInput&) = delete;
@@ -54,7 +55,7 @@ protected:
 };
 
 /// A regular file opened for reading.
-class InputFile final : public ByteInput {
+class CMC33_IO_EXPORT InputFile final : public ByteInput {
 public:
     /// Opens `path`; `label` starts every message. @throws Error{io_error} if the file is missing,
     /// unreadable, a directory or not a regular file (a FIFO would block).

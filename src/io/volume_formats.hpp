@@ -55,7 +55,7 @@ std::string_view trim(std::string_view text) noexcept;
 std::vector<std::string_view> split_words(std::string_view text);
 /// Words joined by one space (collapses runs of blanks).
 std::string normalize_blanks(std::string_view text);
-std::string lower_ascii(std::string_view text);
+CMC33_IO_EXPORT std::string lower_ascii(std::string_view text);
 bool equals_ignore_case(std::string_view a, std::string_view b) noexcept;
 /// Shortest decimal that reads back as exactly `value`.
 std::string format_real(double value);
@@ -212,12 +212,13 @@ Volume read_npy(const ByteInput& file, const ReadOptions& options, const ReadSam
 Volume read_vti(const ByteInput& file, const ReadOptions& options);
 /// The format of nifti.cpp, npy.cpp or vti.cpp that the first bytes of `file` show (a gzip stream
 /// is inflated far enough to see a NIfTI header), or nullopt.
-std::optional<VolumeFormat> sniff_volume_format(const ByteInput& file);
+CMC33_IO_EXPORT std::optional<VolumeFormat> sniff_volume_format(const ByteInput& file);
 
 /// Moves a frame into the anatomical space `target` ("ras", "lps" or a NRRD name): negates the
 /// world axes whose direction differs (world_space.cpp). @throws Error{invalid_argument} naming
 /// `label` for an unknown target, a frame without a space, or a space that is not anatomical.
-void convert_space(Vec3& origin, Mat3& direction, std::string& space, std::string_view target, const std::string& label);
+CMC33_IO_EXPORT void convert_space(Vec3& origin, Mat3& direction, std::string& space, std::string_view target,
+                                   const std::string& label);
 
 /// The data file a detached header names: "<stem>.raw" in the header's folder.
 std::filesystem::path data_file_beside(const std::filesystem::path& header);

@@ -99,7 +99,7 @@ struct MeshOpsReport {
     MeshGeometry geometry_before, geometry_after;
     HausdorffResult hausdorff;
     /// Same topology: euler, components, closed components, b1, boundary loops, manifoldness.
-    bool topology_same() const noexcept;
+    CMC33_MESH_OPS_EXPORT bool topology_same() const noexcept;
 };
 CMC33_MESH_OPS_EXPORT MeshOpsReport compare_meshes(const Mesh& before, const Mesh& after, int threads = 0);
 
