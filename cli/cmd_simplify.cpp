@@ -198,8 +198,8 @@ void add_simplify(CLI::App& app)
         ->type_name("E")
         ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--max-distance", args->max_distance,
-                    "Refuse a collapse that leaves an input vertex merged into it farther than D from its "
-                    "triangles (world units): bounds how far the input's vertices drift")
+                    "Refuse a collapse that would leave an input vertex merged into it farther than D from its "
+                    "new triangles, or those triangles farther than D from the input there (world units)")
         ->type_name("D")
         ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--smooth", args->smooth, "Taubin lambda|mu smoothing, N iterations, after simplifying")

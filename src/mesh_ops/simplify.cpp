@@ -329,15 +329,15 @@ struct Simplifier {
     }
 
     /// Whether the triangles `new_tris_` would make (a at p) stay within the bound of the input
-    /// both ways, as far as the input vertices merged into a or b tell: each of those vertices near
-    /// the new triangles, and the new vertex and the new triangles' centroids near their input
-    /// triangles.
+    /// both ways, as far as the input vertices merged into a or b tell: the new vertex, the new
+    /// triangles' centroids and the midpoints of their edges at the new vertex near the input
+    /// triangles at those vertices, and each of those vertices near the new triangles.
     bool within_bound(std::uint32_t a, std::uint32_t b, const Pos& p) const
     {
         if (!std::isfinite(max_distance_sq)) return true;
-        const auto at = [&](std::uint32_t v) { return v == a ? point(p) : point(m.pos[v]); };
-        if (!near_input(point(p), a, b)) return false;
         const V3 c = point(p);
+        const auto at = [&](std::uint32_t v) { return v == a ? c : point(m.pos[v]); };
+        if (!near_input(c, a, b)) return false;
         for (const Tri& t : new_tris_) {
             const V3 x = at(t[0]), y = at(t[1]), z = at(t[2]);
             if (!near_input({(x[0] + y[0] + z[0]) / 3, (x[1] + y[1] + z[1]) / 3, (x[2] + y[2] + z[2]) / 3}, a, b)) return false;
@@ -416,14 +416,15 @@ struct Simplifier {
                 new_tris_.push_back(c);
             }
         }
-        const Refusal r = m.check(changed_, new_tris_, a, p, shared_);
-        if (r == Refusal::flip) ++stats.refused_flip;
-        if (r == Refusal::intersection) ++stats.refused_intersection;
-        if (r != Refusal::none) return false;
+        // the distance bound first: a few point-triangle distances, cheaper than the exact checks
         if (!within_bound(a, b, p)) {
             ++stats.refused_distance;
             return false;
         }
+        const Refusal r = m.check(changed_, new_tris_, a, p, shared_);
+        if (r == Refusal::flip) ++stats.refused_flip;
+        if (r == Refusal::intersection) ++stats.refused_intersection;
+        if (r != Refusal::none) return false;
         // apply
         for (const std::uint32_t t : shared_) {
             m.grid.remove(t);

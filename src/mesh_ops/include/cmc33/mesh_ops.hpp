@@ -36,7 +36,7 @@ struct SimplifyStats {
     std::int64_t refused_topology = 0;   ///< refused by the link condition or a locked vertex
     std::int64_t refused_flip = 0;       ///< refused: a triangle would turn by more than 90 degrees or vanish
     std::int64_t refused_intersection = 0; ///< refused: a new triangle would meet another improperly
-    std::int64_t refused_distance = 0;   ///< refused: an input vertex would end farther than max_distance
+    std::int64_t refused_distance = 0;   ///< refused by the distance bound (max_distance; checked first)
     double max_quadric_error = 0;        ///< the largest quadric error of a collapse done (world units, square-rooted)
 };
 
