@@ -6,8 +6,7 @@
 #                  library as shared libraries: hidden symbols, the API exported), runs it, then
 #                  installs that same build of the library into WORK/prefix and builds and runs a
 #                  second consumer with find_package(cmc33): both ways of consuming the source, and
-#                  the shared package, for one compile of the library; the first build also makes
-#                  the cmc33 tool against the shared libraries and runs it once
+#                  the shared package, for one compile of the library
 # Also needs -DSOURCE=<this folder> and -DGENERATOR=<CMake generator>. Each consumer prints how it
 # got cmc33::core (package or subdirectory, and the library's type); the test's regular
 # expressions check those lines.
@@ -32,16 +31,7 @@ function(consume build)
 endfunction()
 if(MODE STREQUAL "shared")
     consume(${WORK}/subdirectory ${unoptimised} -DCMC33_CONSUME=subdirectory -DCMC33_SOURCE_DIR=${CMC33_SOURCE}
-            -DBUILD_SHARED_LIBS=ON -DCMC33_BUILD_CLI=ON)
-    # the command-line tool against the shared libraries: it calls the parts' exported internals
-    # (io's input files and format sniffing), which a static build never tests
-    execute_process(COMMAND ${WORK}/subdirectory/cmc33/cli/cmc33 extract ${CMC33_SOURCE}/data/Bucky_32x32x32_uint8.nrrd
-                            --iso 100.5 --json -o ${WORK}/bucky.ply
-                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-    if(NOT rc EQUAL 0 OR NOT out MATCHES "\"triangles\": 11808")
-        message(FATAL_ERROR "failed (${rc}): the cmc33 tool on shared libraries: ${err}${out}")
-    endif()
-    message(STATUS "the cmc33 tool on shared libraries: Bucky's 11808 triangles")
+            -DBUILD_SHARED_LIBS=ON)
     # the library's binary folder inside the consumer's build (add_subdirectory(... cmc33)): its
     # install rules alone, the consumer has none
     run(${CMAKE_COMMAND} --install ${WORK}/subdirectory/cmc33 --prefix ${WORK}/prefix)
