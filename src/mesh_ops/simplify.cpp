@@ -139,13 +139,19 @@ struct Simplifier {
     std::vector<std::uint32_t> version;
     std::priority_queue<Candidate> heap;
     SimplifyStats stats;
-    /// With a distance bound: the input's vertices, and per vertex the input vertices merged into it
-    /// (a list through cluster_next from the vertex itself to cluster_tail, kNone-terminated).
+    /// With a distance bound: the input's vertices and triangles; per vertex the input vertices
+    /// merged into it (a list through cluster_next from the vertex itself to cluster_tail,
+    /// kNone-terminated); and per live triangle the input vertices assigned to it (a list from
+    /// assigned_first through assigned_next), each within the bound of that triangle.
     double max_distance_sq = std::numeric_limits<double>::infinity();
     std::vector<V3> input;
     std::vector<Tri> input_tri;
     std::vector<std::uint32_t> input_star_first, input_star; ///< per input vertex its input triangles
+    /// per input triangle: its centroid and (radius + bound)^2, the radius the farthest corner's
+    /// distance from it; a point farther from the centroid is beyond the bound of the triangle
+    std::vector<std::array<double, 4>> input_ball;
     std::vector<std::uint32_t> cluster_next, cluster_tail;
+    std::vector<std::uint32_t> assigned_first, assigned_next;
     static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
 
     Simplifier(const Mesh& mesh, double max_distance) : m(mesh), quadric(m.pos.size()), version(m.pos.size(), 0)
@@ -168,6 +174,25 @@ struct Simplifier {
             std::vector<std::uint32_t> fill(input_star_first.begin(), input_star_first.end() - 1);
             for (std::size_t t = 0; t < input_tri.size(); ++t)
                 for (const std::uint32_t v : input_tri[t]) input_star[fill[v]++] = static_cast<std::uint32_t>(t);
+            // each input vertex starts on a triangle of its own star (distance 0); unused ones on none
+            assigned_first.assign(m.tri.size(), kNone);
+            assigned_next.assign(m.pos.size(), kNone);
+            for (std::size_t v = 0; v < m.pos.size(); ++v) {
+                if (m.vtris[v].empty()) continue;
+                const std::uint32_t t = m.vtris[v].front();
+                assigned_next[v] = assigned_first[t];
+                assigned_first[t] = static_cast<std::uint32_t>(v);
+            }
+            input_tri_mark.assign(input_tri.size(), 0);
+            input_ball.resize(input_tri.size());
+            for (std::size_t t = 0; t < input_tri.size(); ++t) {
+                const V3 &x = input[input_tri[t][0]], &y = input[input_tri[t][1]], &z = input[input_tri[t][2]];
+                const V3 o{(x[0] + y[0] + z[0]) / 3, (x[1] + y[1] + z[1]) / 3, (x[2] + y[2] + z[2]) / 3};
+                const double r = std::sqrt(std::max({mesh_ops::dot(mesh_ops::sub(x, o), mesh_ops::sub(x, o)),
+                                                     mesh_ops::dot(mesh_ops::sub(y, o), mesh_ops::sub(y, o)),
+                                                     mesh_ops::dot(mesh_ops::sub(z, o), mesh_ops::sub(z, o))}));
+                input_ball[t] = {o[0], o[1], o[2], (r + max_distance) * (r + max_distance)};
+            }
         }
         for (std::size_t t = 0; t < m.tri.size(); ++t) {
             const Tri& c = m.tri[t];
@@ -314,49 +339,121 @@ struct Simplifier {
         return {static_cast<double>(p[0]), static_cast<double>(p[1]), static_cast<double>(p[2])};
     }
 
-    /// Whether x lies within the bound of the input triangles at the input vertices merged into a or b.
-    bool near_input(const V3& x, std::uint32_t a, std::uint32_t b) const
+    std::vector<std::array<V3, 3>> new_corners_; ///< the corners of new_tris_, the moved vertex at its new place
+    std::vector<std::array<double, 4>> new_ball_; ///< per new triangle: its centroid and the farthest corner's distance
+    std::vector<std::uint32_t> moving_;         ///< input vertices assigned to triangles the collapse changes or removes
+    std::vector<std::uint32_t> moving_to_;      ///< per moving_ vertex: its nearest new triangle (index into new_tris_)
+    std::vector<std::uint32_t> near_input_;     ///< input triangles the new triangles' samples are compared with
+    std::vector<std::uint32_t> input_tri_mark;
+    std::uint32_t input_tri_stamp = 0;
+
+    void add_star_of_cluster(std::uint32_t v)
     {
-        for (const std::uint32_t start : {a, b}) {
-            for (std::uint32_t q = start; q != kNone; q = cluster_next[q]) {
-                for (std::uint32_t i = input_star_first[q]; i < input_star_first[q + 1]; ++i) {
-                    const Tri& t = input_tri[input_star[i]];
-                    if (mesh_ops::point_triangle_sq(x, input[t[0]], input[t[1]], input[t[2]]) <= max_distance_sq) return true;
-                }
-            }
+        for (std::uint32_t q = v; q != kNone; q = cluster_next[q]) add_star(q);
+    }
+    void add_star(std::uint32_t q)
+    {
+        for (std::uint32_t i = input_star_first[q]; i < input_star_first[q + 1]; ++i) {
+            const std::uint32_t t = input_star[i];
+            if (input_tri_mark[t] == input_tri_stamp) continue;
+            input_tri_mark[t] = input_tri_stamp;
+            near_input_.push_back(t);
         }
-        return false;
     }
 
-    /// Whether the triangles `new_tris_` would make (a at p) stay within the bound of the input
-    /// both ways, as far as the input vertices merged into a or b tell: the new vertex, the new
-    /// triangles' centroids and the midpoints of their edges at the new vertex near the input
-    /// triangles at those vertices, and each of those vertices near the new triangles.
-    bool within_bound(std::uint32_t a, std::uint32_t b, const Pos& p) const
+    /// Whether the collapse of b into a (a at p), whose triangles are new_tris_, keeps the surface
+    /// within the bound of the input.
+    ///
+    /// Guaranteed (input to output): every input vertex stays within the bound of the live triangle
+    /// it is assigned to. Those assigned to a triangle the collapse changes or removes must each find
+    /// a new triangle within the bound (they move to the nearest one), else the collapse is refused;
+    /// the other triangles do not move, so their input vertices stay near.
+    ///
+    /// Sampled (output to input): the new vertex, each new triangle's centroid and the midpoints of
+    /// its edges at the new vertex (every other edge of the mesh was sampled when last made) must
+    /// each lie within the bound of an input triangle of the local set: the stars of the input
+    /// vertices above, and of the input vertices merged into a, b and the other corners of the new
+    /// triangles. Points between the samples, and input triangles outside that set, are not looked at.
+    bool within_bound(std::uint32_t a, std::uint32_t b, const Pos& p)
     {
         if (!std::isfinite(max_distance_sq)) return true;
         const V3 c = point(p);
-        const auto at = [&](std::uint32_t v) { return v == a ? c : point(m.pos[v]); };
-        if (!near_input(c, a, b)) return false;
+        new_corners_.clear();
+        new_ball_.clear();
         for (const Tri& t : new_tris_) {
-            const V3 x = at(t[0]), y = at(t[1]), z = at(t[2]);
-            if (!near_input({(x[0] + y[0] + z[0]) / 3, (x[1] + y[1] + z[1]) / 3, (x[2] + y[2] + z[2]) / 3}, a, b)) return false;
-            // the midpoints of its edges at the new vertex (the third edge is an old one)
-            for (const V3& w : {x, y, z}) {
-                if (w == c) continue;
-                if (!near_input({(w[0] + c[0]) / 2, (w[1] + c[1]) / 2, (w[2] + c[2]) / 2}, a, b)) return false;
-            }
+            std::array<V3, 3> x{};
+            for (std::size_t i = 0; i < 3; ++i) x[i] = t[i] == a ? c : point(m.pos[t[i]]);
+            new_corners_.push_back(x);
+            const V3 o{(x[0][0] + x[1][0] + x[2][0]) / 3, (x[0][1] + x[1][1] + x[2][1]) / 3, (x[0][2] + x[1][2] + x[2][2]) / 3};
+            double r = 0;
+            for (const V3& y : x) r = std::max(r, mesh_ops::dot(mesh_ops::sub(y, o), mesh_ops::sub(y, o)));
+            new_ball_.push_back({o[0], o[1], o[2], std::sqrt(r)});
         }
-        for (const std::uint32_t start : {a, b}) {
-            for (std::uint32_t q = start; q != kNone; q = cluster_next[q]) {
-                bool near = false;
-                for (const Tri& t : new_tris_) {
-                    if (mesh_ops::point_triangle_sq(input[q], at(t[0]), at(t[1]), at(t[2])) <= max_distance_sq) {
-                        near = true;
-                        break;
-                    }
+        // input to output: each input vertex of a changed or removed triangle finds a new one near it
+        moving_.clear();
+        moving_to_.clear();
+        for (const auto* list : {&changed_, &shared_})
+            for (const std::uint32_t t : *list)
+                for (std::uint32_t q = assigned_first[t]; q != kNone; q = assigned_next[q]) moving_.push_back(q);
+        const double just_over = std::nextafter(max_distance_sq, std::numeric_limits<double>::infinity());
+        for (const std::uint32_t q : moving_) {
+            // the nearest (the first of equals) within the bound; a triangle whose ball is not
+            // nearer than the best so far is skipped
+            double best = just_over;
+            std::uint32_t at = kNone;
+            for (std::size_t i = 0; i < new_corners_.size(); ++i) {
+                const auto& ball = new_ball_[i];
+                const double off = std::sqrt(mesh_ops::dot(mesh_ops::sub(input[q], {ball[0], ball[1], ball[2]}),
+                                                           mesh_ops::sub(input[q], {ball[0], ball[1], ball[2]}))) - ball[3];
+                if (off > 0 && off * off >= best) continue;
+                const auto& x = new_corners_[i];
+                const double d = mesh_ops::point_triangle_sq(input[q], x[0], x[1], x[2]);
+                if (d < best) {
+                    best = d;
+                    at = static_cast<std::uint32_t>(i);
                 }
-                if (!near) return false;
+            }
+            if (at == kNone) return false;
+            moving_to_.push_back(at);
+        }
+        // output to input: samples of the new triangles against the local input triangles
+        if (++input_tri_stamp == 0) {
+            std::fill(input_tri_mark.begin(), input_tri_mark.end(), 0U);
+            input_tri_stamp = 1;
+        }
+        near_input_.clear();
+        for (const std::uint32_t q : moving_) add_star(q);
+        add_star_of_cluster(a);
+        add_star_of_cluster(b);
+        for (const Tri& t : new_tris_)
+            for (const std::uint32_t v : t)
+                if (v != a) add_star_of_cluster(v);
+        // the scan starts where the last sample found its triangle: neighbouring samples tend to
+        // share one (the answer does not depend on the order)
+        std::size_t hint = 0;
+        const auto near = [&](const V3& x) {
+            const std::size_t n = near_input_.size();
+            for (std::size_t k = 0; k < n; ++k) {
+                const std::size_t j = hint + k < n ? hint + k : hint + k - n;
+                const auto& ball = input_ball[near_input_[j]];
+                const double dx = x[0] - ball[0], dy = x[1] - ball[1], dz = x[2] - ball[2];
+                if (dx * dx + dy * dy + dz * dz > ball[3]) continue;
+                const Tri& t = input_tri[near_input_[j]];
+                if (mesh_ops::point_triangle_sq(x, input[t[0]], input[t[1]], input[t[2]]) <= max_distance_sq) {
+                    hint = j;
+                    return true;
+                }
+            }
+            return false;
+        };
+        if (!near(c)) return false;
+        for (const auto& t : new_corners_) {
+            const V3 &x = t[0], &y = t[1], &z = t[2];
+            if (!near({(x[0] + y[0] + z[0]) / 3, (x[1] + y[1] + z[1]) / 3, (x[2] + y[2] + z[2]) / 3})) return false;
+            // the midpoints of its edges at the new vertex (the third edge is an old one)
+            for (const V3& w : t) {
+                if (w == c) continue;
+                if (!near({(w[0] + c[0]) / 2, (w[1] + c[1]) / 2, (w[2] + c[2]) / 2})) return false;
             }
         }
         return true;
@@ -448,6 +545,13 @@ struct Simplifier {
         if (!cluster_next.empty()) {
             cluster_next[cluster_tail[a]] = b;
             cluster_tail[a] = cluster_tail[b];
+            for (const std::uint32_t t : shared_) assigned_first[t] = kNone;
+            for (const std::uint32_t t : changed_) assigned_first[t] = kNone;
+            for (std::size_t i = 0; i < moving_.size(); ++i) {
+                const std::uint32_t t = changed_[moving_to_[i]];
+                assigned_next[moving_[i]] = assigned_first[t];
+                assigned_first[t] = moving_[i];
+            }
         }
         ++version[a];
         ++version[b];
