@@ -198,8 +198,10 @@ void add_simplify(CLI::App& app)
         ->type_name("E")
         ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--max-distance", args->max_distance,
-                    "Refuse a collapse that would leave an input vertex merged into it farther than D from its "
-                    "new triangles, or those triangles farther than D from the input there (world units)")
+                    "Keep every input vertex within D of the simplified surface (guaranteed, world units; "
+                    "--smooth does not keep it), and refuse a collapse that puts the new vertex, a new "
+                    "triangle's centroid or an edge midpoint at the new vertex farther than D from the input "
+                    "triangles nearby (sampled: points between them may be farther)")
         ->type_name("D")
         ->check(CLI::Range(0.0, std::numeric_limits<double>::max()));
     cmd->add_option("--smooth", args->smooth, "Taubin lambda|mu smoothing, N iterations, after simplifying")

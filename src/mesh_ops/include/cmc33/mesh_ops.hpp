@@ -23,9 +23,16 @@ struct SimplifyOptions {
     /// Stop before a collapse whose quadric error (the sum of squared distances of the new vertex
     /// to the planes of the input triangles merged into it) exceeds max_error squared, world units.
     double max_error = std::numeric_limits<double>::infinity();
-    /// Refuse a collapse that would leave an input vertex merged into the new vertex farther than
-    /// this from the new vertex's triangles (world units): a bound on how far the input's vertices
-    /// drift from the output (infinity: none).
+    /// A distance bound, world units (infinity: none). Guaranteed: every input vertex (of a
+    /// triangle) ends within it of the output surface: each is assigned to a triangle within it,
+    /// and a collapse is refused when those of the triangles it changes cannot all find a new one.
+    /// Sampled: a collapse is also refused when the new vertex, a new triangle's centroid or the
+    /// midpoint of a new edge would be farther than this from the input triangles at the input
+    /// vertices merged into the new triangles' corners or assigned to the changed triangles. Every
+    /// output vertex, centroid and edge midpoint has been so checked (or is the input's own), so a
+    /// point of an output triangle is within the bound plus its longest edge / (2 sqrt 3) of the
+    /// input, and a point of an input triangle within the bound plus its longest edge / sqrt 3 of
+    /// the output.
     double max_distance = std::numeric_limits<double>::infinity();
     /// Optional: called with the fraction done; false stops (Error{cancelled}).
     std::function<bool(double fraction)> progress;
