@@ -17,6 +17,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "extract_report.hpp"
+#include "plural.hpp"
 
 namespace cmc33::cli {
 
@@ -112,9 +113,16 @@ void run_extract(const ExtractArgs& args)
         geometry = check.geometry;
         structured = check.structured;
     }
+    // the steps of `cmc33 simplify`, from what the check found; the mesh written is their result
+    std::optional<MeshStepsResult> steps;
+    if (args.steps.any()) {
+        steps = run_mesh_steps(mesh, args.steps, StepsContext{args.input, args.progress, args.quiet, args.threads},
+                               &topology, &geometry);
+    }
+    const Mesh& written = steps ? steps->mesh : mesh;
     if (!args.output.empty()) {
         named_step(args.output, "writing the mesh",
-                   [&] { io::write_mesh(mesh, args.output, io::MeshWriteOptions{args.ascii, offset, volume.space()}); });
+                   [&] { io::write_mesh(written, args.output, io::MeshWriteOptions{args.ascii, offset, volume.space()}); });
     }
     if (offset) volume.set_origin(*offset);
 
@@ -135,6 +143,12 @@ void run_extract(const ExtractArgs& args)
     // how the check ran: with the grid's structure, or the general checks (a mesh the grid's layout
     // does not describe: cmc33-paper's refined grid, or one with coincident vertices)
     report.extra["check"] = args.no_topology ? Json(nullptr) : Json(structured ? "structured" : "general");
+    if (steps) {
+        report.extra["simplify"] = mesh_steps_json(*steps, args.steps);
+        report.steps_text = counted(static_cast<std::int64_t>(steps->mesh.triangle_count()), "triangle") +
+                            (steps->dropped > 0 ? " (" + counted(steps->dropped, "component") + " dropped)" : std::string()) +
+                            " in " + sig(steps->seconds, 3) + " s, " + mesh_steps_text(*steps);
+    }
     print_extract_report(args, report);
 }
 
@@ -181,6 +195,7 @@ void add_extract(CLI::App& app)
                     "volumes and meshes larger than memory; binary .ply only, same bytes")
         ->type_name("SIZE")
         ->check(memory_size());
+    add_mesh_step_options(cmd, args->steps);
     add_raw_volume_options(*cmd, args->raw);
     cmd->footer(
         "Reads INPUT, extracts the triangle mesh of the isosurface at ISO with Marching Cubes 33\n"
@@ -193,13 +208,26 @@ void add_extract(CLI::App& app)
         "--memory-limit streams: the volume is read twice, slab by slab (count, then emit), and the\n"
         "mesh written as it is made; the file is byte for byte the one written without it, and the\n"
         "time reported is then the whole run's (reading and writing included).\n"
+        "--ratio, --triangles, --max-error, --smooth, --largest and --min-size then do what\n"
+        "`cmc33 simplify` does to the checked mesh (the same refusals and checks; --json: under\n"
+        "\"simplify\"), and the result is written; the counts at the top are the extraction's.\n"
         "\n"
         "Examples:\n"
         "  cmc33 extract aneurism.nrrd --iso 80 -o vessels.ply\n"
         "  cmc33 extract scan.raw --dims 256 256 128 --type uint16 --endian big -i 600 --json\n"
         "  cmc33 extract bonsai.nrrd -i 40 --method mc --repeat 5 --threads 1\n"
-        "  cmc33 extract scan_4096.nrrd -i 900 -o bone.ply --memory-limit 4G");
+        "  cmc33 extract scan_4096.nrrd -i 900 -o bone.ply --memory-limit 4G\n"
+        "  cmc33 extract skull.nrrd -i 500 -o print.stl --ratio 0.1 --smooth 20 --largest");
     cmd->callback([args] {
+        check_mesh_steps(args->steps);
+        if (args->steps.any() && args->no_topology) {
+            throw UsageError("--no-topology skips the check the simplification starts from (its topology must be kept): "
+                             "not with --ratio, --triangles, --max-error, --smooth, --largest or --min-size");
+        }
+        if (args->steps.any() && !args->memory_limit.empty()) {
+            throw UsageError("--memory-limit writes the mesh slab by slab as it is made; --ratio, --triangles, --max-error, "
+                             "--smooth, --largest and --min-size need it whole: run cmc33 simplify on the file it writes");
+        }
         if (args->memory_limit.empty()) {
             run_extract(*args);
             return;

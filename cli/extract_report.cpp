@@ -65,6 +65,7 @@ void print_extract_report(const ExtractArgs& args, const ExtractReport& r)
                                           ", " + counted(geometry.zero_area_triangles, "zero-area triangle") + ", " +
                                           counted(geometry.intersecting_pairs, "intersecting triangle pair") + ")";
     }
+    if (!r.steps_text.empty()) line += "; then " + r.steps_text;
     if (!args.output.empty()) line += " (" + args.output + ")";
     std::cout << line << '\n';
 }

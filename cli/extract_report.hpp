@@ -9,6 +9,7 @@
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
 #include "common.hpp"
+#include "mesh_steps.hpp"
 
 namespace cmc33::cli {
 
@@ -28,6 +29,7 @@ struct ExtractArgs {
     std::string memory_limit; ///< empty: the volume and the mesh in memory
     std::string positions = "auto"; ///< auto, float or double (--positions)
     RawVolumeOptions raw;
+    MeshSteps steps; ///< --ratio, --smooth and the others of `cmc33 simplify`, after the check
 };
 
 struct ExtractReport {
@@ -43,7 +45,8 @@ struct ExtractReport {
     MeshGeometry geometry;
     bool welded_known = true;          ///< geometry.welded was computed
     ExtractStats stats;
-    Json extra = Json::object();       ///< further JSON keys (memory_limit, slabs)
+    Json extra = Json::object();       ///< further JSON keys (memory_limit, slabs, simplify)
+    std::string steps_text;            ///< the summary line's account of MeshSteps, if any ran
 };
 
 /// Prints the summary line or, with --json, the JSON object.
