@@ -1,12 +1,8 @@
 // cmc33 simplify: fewer triangles, smoother, small pieces dropped, with the topology and the
 // embedding kept and shown (before and after), and the Hausdorff distance to the input.
 
-#include <algorithm>
-#include <chrono>
-#include <limits>
 #include <iostream>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "cmc33/error.hpp"

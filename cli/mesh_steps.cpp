@@ -87,21 +87,22 @@ MeshStepsResult run_mesh_steps(const Mesh& input, const MeshSteps& steps, const 
 {
     MeshStepsResult r;
     const auto start = std::chrono::steady_clock::now();
-    r.mesh = input;
+    // the mesh the steps start from: the input itself, or what the component filter kept (no copy)
+    Mesh filtered;
     if (steps.filters()) {
-        r.mesh = named_step(c.file, "finding components", [&] {
+        filtered = named_step(c.file, "finding components", [&] {
             return filter_components(input, ComponentFilter{steps.largest, steps.min_size}, &r.dropped);
         });
     }
+    const Mesh& start_mesh = steps.filters() ? filtered : input;
     // what a check of the input said holds for the mesh the steps start from if no component went
     const bool known = r.dropped == 0 && known_topology && known_geometry;
     MeshGeometryOptions geometry_options;
     geometry_options.threads = c.threads;
-    r.before = known ? *known_topology : named_step(c.file, "computing the mesh's topology", [&] { return mesh_topology(r.mesh); });
+    r.before = known ? *known_topology : named_step(c.file, "computing the mesh's topology", [&] { return mesh_topology(start_mesh); });
     r.geometry_before = known ? *known_geometry : named_step(c.file, "checking the mesh in space", [&] {
-        return mesh_geometry(r.mesh, geometry_options);
+        return mesh_geometry(start_mesh, geometry_options);
     });
-    const Mesh start_mesh = r.mesh;
     if (steps.simplifies()) {
         SimplifyOptions o;
         if (steps.ratio) o.ratio = *steps.ratio;
@@ -121,10 +122,11 @@ MeshStepsResult run_mesh_steps(const Mesh& input, const MeshSteps& steps, const 
         const auto t0 = std::chrono::steady_clock::now();
         r.mesh = with_progress(c, "smoothing", [&](const Progress& p) {
             o.progress = p;
-            return smooth(r.mesh, o, &r.smooth);
+            return smooth(steps.simplifies() ? r.mesh : start_mesh, o, &r.smooth);
         });
         r.smooth_seconds = seconds_since(t0);
     }
+    if (!steps.simplifies() && steps.smooth == 0) r.mesh = start_mesh; // components dropped only
     r.seconds = seconds_since(start);
     r.after = named_step(c.file, "computing the result's topology", [&] { return mesh_topology(r.mesh); });
     r.geometry_after = named_step(c.file, "checking the result in space", [&] { return mesh_geometry(r.mesh, geometry_options); });
