@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -42,14 +43,14 @@ void RangeExtractor<T>::emit(const RangeCounts& c, const RangeOffsets& off, cons
     if ((c.t_.vertices > 0 && out.positions == nullptr) || (c.t_.triangles > 0 && out.triangles == nullptr)) {
         throw Error(Status::invalid_argument, "emit: MeshSpans needs positions and triangles");
     }
-    const Emit e{c, off, out, gradient_scale(c.t_.largest_sample)};
+    std::optional<VertexCellRanges<T>> ranges;
+    if (out.vertex_cell_ranges) ranges.emplace(g_, k0, x_valid_, out.vertex_cell_ranges);
+    const Emit e{c, off, out, gradient_scale(c.t_.largest_sample), ranges ? &*ranges : nullptr};
     Scratch s(nx_, ny_);
-    if (out.vertex_cell_ranges) s.ranges.emplace(nx_, ny_);
     std::size_t decision = 0; // the next of count's decisions
     bool finished = false;    // not stopped by the ticker
     switch (outputs_of(out)) {
     case Outputs::plain: finished = emit_planes<Outputs::plain>(e, s, ticker, decision); break;
-    case Outputs::drop_in: finished = emit_planes<Outputs::drop_in>(e, s, ticker, decision); break;
     case Outputs::all: finished = emit_planes<Outputs::all>(e, s, ticker, decision); break;
     }
     if (!finished) return;
@@ -95,12 +96,14 @@ bool RangeExtractor<T>::emit_planes(const Emit& e, Scratch& s, Ticker* ticker, s
             if (r.v1 == r.xy0 && r.t1 == r.t0) continue;
             std::int64_t interior = 0;
             const std::uint32_t* ids = row_ids(j, k, s, e, interior);
-            // the cells' ranges before the vertices, which take them from the cells around
-            if (kOut != Outputs::plain && s.ranges && r.t1 != r.t0) write_cell_ranges(j, k, r, s);
             const Word* f[4];
             detail::RowSigns unused[4];
             flags_around(j, k, s, f, unused);
-            if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, f, ids, s, e);
+            if constexpr (kOut == Outputs::all) {
+                // the cells' ranges before the vertices, which take them from the cells around
+                if (e.ranges && r.t1 != r.t0) e.ranges->cell_row(j, k, f, r.lo, r.hi);
+            }
+            if (r.xy0 != r.xy1 || r.z0 != r.v1) emit_row_vertices<kOut>(j, k, r, f, ids, e);
             std::int64_t vertex_end = interior, triangle_end = e.off.first_triangle + r.t0;
             if (r.t1 != r.t0) emit_row_cells<kOut>(j, k, r, f, s, e, vertex_end, triangle_end, decision);
             if (vertex_end != e.off.first_vertex + r.v1 || triangle_end != e.off.first_triangle + r.t1) {
@@ -110,61 +113,6 @@ bool RangeExtractor<T>::emit_planes(const Emit& e, Scratch& s, Ticker* ticker, s
         if (ticker && !ticker->tick()) return false;
     }
     return true;
-}
-
-template <class T>
-typename RangeExtractor<T>::CellsAround RangeExtractor<T>::cells_around(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e) const
-{
-    CellRangeRows& rows = *s.ranges;
-    const auto cell_row = [&](std::int64_t cj, std::int64_t ck) {
-        // cells outside the grid, and the previous range's plane (edge_cell_range() there)
-        const bool exists = cj >= 0 && cj + 1 < ny_ && ck >= e.c.t_.k0 && ck + 1 < nz_;
-        return exists ? rows.row(cj, ck) : rows.zero();
-    };
-    return {{cell_row(j - 1, k - 1), cell_row(j, k - 1)}, {cell_row(j - 1, k), cell_row(j, k)}, k == e.c.t_.k0 && k > 0};
-}
-
-template <class T>
-void RangeExtractor<T>::write_cell_ranges(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s) const
-{
-    // the narrowest type whose difference, rounded to float, is cell_range()'s: float for
-    // float (rounding through double first is innocuous: 53 >= 2 * 24 + 2 bits), int for 8-
-    // and 16-bit samples; these vectorize, Exact's int64 would not
-    using Difference = std::conditional_t<std::is_same_v<T, float>, float,
-                                          std::conditional_t<(sizeof(T) <= 2), int, Exact>>;
-    float* ranges = s.ranges->row(j, k) + 1;
-    const Word* f00 = flags(j, k, s);
-    const Word* f10 = flags(j + 1, k, s);
-    const Word* f01 = flags(j, k + 1, s);
-    const Word* f11 = flags(j + 1, k + 1, s);
-    const T* a = g_.data + g_.offset(0, j, k);
-    const T* b = a + g_.strides[1];
-    const T* c = a + g_.strides[2];
-    const T* d = b + g_.strides[2];
-    for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
-        Word bits = crossed_cells(f00, f10, f01, f11, w, x_valid_[static_cast<std::size_t>(w)]);
-        if (sx_ == 1) {
-            while (bits != 0) {
-                const int first = std::countr_zero(bits);
-                const std::int64_t i = 64 * w + first;
-                if (i + 8 >= nx_) break; // the last cells read past the row: one by one
-                // cell_range()'s tree spelled out on the four rows: through a shared helper
-                // the loop stops vectorizing
-                for (std::int64_t q = i; q < i + 8; ++q) {
-                    const T low = std::min(std::min(std::min(a[q], a[q + 1]), std::min(b[q], b[q + 1])),
-                                           std::min(std::min(c[q], c[q + 1]), std::min(d[q], d[q + 1])));
-                    const T high = std::max(std::max(std::max(a[q], a[q + 1]), std::max(b[q], b[q + 1])),
-                                            std::max(std::max(c[q], c[q + 1]), std::max(d[q], d[q + 1])));
-                    ranges[q] = static_cast<float>(static_cast<Difference>(high) - static_cast<Difference>(low));
-                }
-                bits &= ~(Word{0xff} << first);
-            }
-        }
-        for (; bits != 0; bits &= bits - 1) {
-            const std::int64_t i = 64 * w + std::countr_zero(bits);
-            ranges[i] = static_cast<float>(cell_range(a + i * sx_));
-        }
-    }
 }
 
 template <class T>
@@ -286,89 +234,38 @@ const detail::Tiling* RangeExtractor<T>::replay(unsigned code, std::uint8_t deci
 }
 
 template <class T>
-CMC33_ALWAYS_INLINE typename RangeExtractor<T>::Exact RangeExtractor<T>::cell_range(const T* p) const
-{
-    const std::int64_t sy = g_.strides[1], sz = g_.strides[2];
-    const T a0 = p[0], a1 = p[sx_], a2 = p[sy], a3 = p[sx_ + sy];
-    const T a4 = p[sz], a5 = p[sx_ + sz], a6 = p[sy + sz], a7 = p[sx_ + sy + sz];
-    const T lo = std::min(std::min(std::min(a0, a1), std::min(a2, a3)), std::min(std::min(a4, a5), std::min(a6, a7)));
-    const T hi = std::max(std::max(std::max(a0, a1), std::max(a2, a3)), std::max(std::max(a4, a5), std::max(a6, a7)));
-    return static_cast<Exact>(hi) - static_cast<Exact>(lo);
-}
-
-template <class T>
-float RangeExtractor<T>::edge_cell_range(std::int64_t i, std::int64_t j, std::int64_t k, int axis) const
-{
-    const std::int64_t idx[3] = {i, j, k}, n[3] = {nx_, ny_, nz_};
-    const auto b = static_cast<std::size_t>((axis + 1) % 3), c = static_cast<std::size_t>((axis + 2) % 3);
-    Exact largest = 0;
-    if (idx[b] >= 1 && idx[b] + 1 < n[b] && idx[c] >= 1 && idx[c] + 1 < n[c]) {
-        // all four cells: the smallest and largest of the edge's 3 x 3 lines of two samples
-        // along `axis`, then each cell's 2 x 2 of those (selects, no branches)
-        const T* p = g_.data + g_.offset(i, j, k);
-        const std::int64_t sa = g_.strides[static_cast<std::size_t>(axis)], sb = g_.strides[b], sc = g_.strides[c];
-        T lo[3][3], hi[3][3];
-        for (std::int64_t u = 0; u < 3; ++u)
-            for (std::int64_t w = 0; w < 3; ++w) {
-                const T* q = p + (u - 1) * sb + (w - 1) * sc;
-                const T x = q[0], y = q[sa];
-                lo[u][w] = x < y ? x : y;
-                hi[u][w] = x < y ? y : x;
-            }
-        for (int u = 0; u < 2; ++u)
-            for (int w = 0; w < 2; ++w) {
-                const T l = std::min(std::min(lo[u][w], lo[u + 1][w]), std::min(lo[u][w + 1], lo[u + 1][w + 1]));
-                const T h = std::max(std::max(hi[u][w], hi[u + 1][w]), std::max(hi[u][w + 1], hi[u + 1][w + 1]));
-                const Exact range = static_cast<Exact>(h) - static_cast<Exact>(l);
-                largest = range > largest ? range : largest;
-            }
-        return static_cast<float>(largest);
-    }
-    for (std::int64_t u = -1; u <= 0; ++u)
-        for (std::int64_t w = -1; w <= 0; ++w) {
-            std::int64_t cell[3] = {i, j, k};
-            cell[b] += u;
-            cell[c] += w;
-            if (cell[b] < 0 || cell[b] + 1 >= n[b] || cell[c] < 0 || cell[c] + 1 >= n[c]) continue;
-            largest = std::max(largest, cell_range(cell[0], cell[1], cell[2]));
-        }
-    return static_cast<float>(largest);
-}
-
-template <class T>
 template <Outputs kOut>
 void RangeExtractor<T>::emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4],
-                       const std::uint32_t* ids, Scratch& s, const Emit& e) const
+                       const std::uint32_t* ids, const Emit& e) const
 {
     const Word *f = rows[0], *fy = rows[1], *fz = rows[2];
-    CellsAround cells{};
-    if constexpr (kOut != Outputs::plain) {
-        if (s.ranges) cells = cells_around(j, k, s, e);
+    if constexpr (kOut == Outputs::all) {
+        if (e.ranges) e.ranges->sample_row(j, k);
     }
     for (std::int64_t w = r.lo / 64; w < (r.hi + 63) / 64; ++w) {
         // an axis at a time: on rough surfaces which of a sample's edges cross is unpredictable
         const EdgeWords edges(f, fy, fz, w, x_valid_[static_cast<std::size_t>(w)]);
-        emit_axis_vertices<0, kOut>(edges.x, w, j, k, ids, cells, e);
-        emit_axis_vertices<1, kOut>(edges.y, w, j, k, ids, cells, e);
-        emit_axis_vertices<2, kOut>(edges.z, w, j, k, ids, cells, e);
+        emit_axis_vertices<0, kOut>(edges.x, w, j, k, ids, e);
+        emit_axis_vertices<1, kOut>(edges.y, w, j, k, ids, e);
+        emit_axis_vertices<2, kOut>(edges.z, w, j, k, ids, e);
     }
 }
 
 template <class T>
 template <int axis, Outputs kOut>
 CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_axis_vertices(Word crossed, std::int64_t w, std::int64_t j, std::int64_t k,
-                                            const std::uint32_t* ids, const CellsAround& cells, const Emit& e) const
+                                            const std::uint32_t* ids, const Emit& e) const
 {
     for (Word bits = crossed; bits != 0; bits &= bits - 1) {
         const std::int64_t i = 64 * w + std::countr_zero(bits);
-        emit_edge_vertex<axis, kOut>(i, j, k, ids[3 * i + axis], cells, e);
+        emit_edge_vertex<axis, kOut>(i, j, k, ids[3 * i + axis], e);
     }
 }
 
 template <class T>
 template <int axis, Outputs kOut>
 CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, std::uint32_t id,
-                                          const CellsAround& cells, const Emit& e) const
+                                          const Emit& e) const
 {
     const MeshSpans& out = e.out;
     const std::int64_t end[3] = {i + (axis == 0), j + (axis == 1), k + (axis == 2)};
@@ -376,21 +273,15 @@ CMC33_ALWAYS_INLINE void RangeExtractor<T>::emit_edge_vertex(std::int64_t i, std
     const double t = crossing(a, b);
     const double u[3] = {axis == 0 ? t : 0.0, axis == 1 ? t : 0.0, axis == 2 ? t : 0.0};
     const auto v = static_cast<std::size_t>(std::int64_t{id} - out.first_vertex);
-    const bool zyx = kOut == Outputs::drop_in || (kOut == Outputs::all && out.zyx);
+    const bool zyx = kOut == Outputs::all && out.zyx;
     write_position(i, j, k, u, &out.positions[v * 3], zyx);
     if (out.normals && !write_normal(&out.normals[v * 3], edge_gradient(i, j, k, axis, t, e.gradient_scale), zyx)) {
         // central differences cancel (alternating samples): the interpolant's own gradient,
         // never 0 on a crossed edge
         write_normal(&out.normals[v * 3], edge_cell_gradient(i, j, k, axis, t, e.gradient_scale), zyx);
     }
-    if constexpr (kOut != Outputs::plain) {
-        if (kOut == Outputs::drop_in || out.vertex_cell_ranges) {
-            // x and y edges of the range's first plane: the cells below are the previous range's
-            out.vertex_cell_ranges[v] = axis != 2 && cells.first_plane ? edge_cell_range(i, j, k, axis)
-                                                                      : cells.template value<axis>(i);
-        }
-    }
     if constexpr (kOut == Outputs::all) {
+        if (e.ranges) e.ranges->template edge_vertex<axis>(v, i, j, k);
         if (out.vertex_edges) out.vertex_edges[v] = 3 * whole_cell(i, j, k) + axis;
         if (out.vertex_parameters) out.vertex_parameters[v] = static_cast<float>(t);
         if (out.vertex_values) {
@@ -420,7 +311,7 @@ void RangeExtractor<T>::emit_row_cells(std::int64_t j, std::int64_t k, const Row
     const MeshSpans& out = e.out;
     const std::int64_t copy_end = e.copy_end();
     const std::uint8_t* const padded_table = padded_codes().data();
-    const bool flip = kOut != Outputs::plain ? mirrored_ != out.reverse_winding : mirrored_;
+    const bool flip = kOut == Outputs::all ? mirrored_ != out.reverse_winding : mirrored_;
     // the short tilings' offsets for this row's parity: from `id_base` (IdRows' slot 0)
     // (none on grids too wide for them: short_count_ is then -1 for every code)
     const std::uint16_t* const short_offsets =

@@ -5,6 +5,8 @@
 //   emit.cpp        pass 3: the vertices of crossed edges and the cells' triangles at the ids the
 //                   scan fixed, with the short-tiling path for small fixed tilings;
 //   vertices.hpp    vertex placement (crossings, interior vertices) and normals (gradients);
+//   cell_ranges.hpp the one per-vertex attribute computed from the cells (scikit-image's
+//                   values, MeshSpans::vertex_cell_ranges), a hook emit calls;
 //   bit_rows.hpp    the above-flags as words and what is read from them.
 // What does not depend on the range (the frame, the grid's place in a larger one, the sign rule,
 // which configurations need the samples) is set up once in the constructor and shared by the
@@ -14,12 +16,12 @@
 #include <array>
 #include <cstdint>
 #include <limits>
-#include <optional>
 #include <string>
 #include <type_traits>
 #include <vector>
 
 #include "bit_rows.hpp"
+#include "cell_ranges.hpp"
 #include "classify.hpp"
 #include "cmc33/error.hpp"
 #include "cmc33/extract.hpp"
@@ -34,9 +36,9 @@ namespace cmc33::detail {
 
 /// Which of MeshSpans' outputs an instantiation of emit's row functions writes. plain:
 /// positions, triangles and normals, the usual output, without the extras' tests (they cost
-/// 2-4 % where not taken); drop_in: those in (z, y, x) with vertex_cell_ranges, scikit-image's
-/// (cmc33.marching_cubes); all: every extra, each tested at run time.
-enum class Outputs { plain, drop_in, all };
+/// 2-4 % where not taken); all: every extra and layout, each tested at run time, and the
+/// per-vertex attribute hook (Emit::ranges) where it is set.
+enum class Outputs { plain, all };
 
 /// A block's place in its larger grid (MeshSpans::index_offset, whole_dims); both zero: the whole.
 struct BlockPlacement {
@@ -93,67 +95,10 @@ private:
 
     static Outputs outputs_of(const MeshSpans& out)
     {
-        if (out.vertex_edges || out.vertex_parameters || out.vertex_values || out.triangle_cells) return Outputs::all;
-        if (out.vertex_cell_ranges && out.zyx) return Outputs::drop_in;
-        return out.vertex_cell_ranges || out.zyx || out.reverse_winding ? Outputs::all : Outputs::plain;
+        const bool extras = out.vertex_edges || out.vertex_parameters || out.vertex_values || out.triangle_cells ||
+                            out.vertex_cell_ranges;
+        return extras || out.zyx || out.reverse_winding ? Outputs::all : Outputs::plain;
     }
-
-    /// MeshSpans::vertex_cell_ranges without a scatter: cell_range() of the crossed cells of two
-    /// cell planes, k (the one emit is in) and k - 1, and an edge vertex's value the largest of
-    /// its up to four cells'. Each plane has a row of nx + 1 floats per cell row, cell i at i + 1;
-    /// entry 0 (cell -1) and entry nx (cell nx - 1) are 0 and never written. The other entries
-    /// are not initialized: only crossed cells are read, all of them written first (a crossed
-    /// edge's cells are all crossed); a plane's row holds the plane two before until then. Cells
-    /// outside the grid or below the range read the zero row.
-    class CellRangeRows {
-    public:
-        CellRangeRows(std::int64_t nx, std::int64_t ny)
-            : len_(static_cast<std::size_t>(nx) + 1), ny_(ny)
-        {
-            ranges_.resize((2 * static_cast<std::size_t>(ny) + 1) * len_);
-#ifndef NDEBUG
-            // debug builds (the sanitizers' in CI) poison the rest: a cell read before it is
-            // written would win every max, and the tests compare the values with their own
-            std::fill(ranges_.begin(), ranges_.end(), std::numeric_limits<float>::infinity());
-#endif
-            for (std::size_t r = 0; r < 2 * static_cast<std::size_t>(ny); ++r) ranges_[r * len_] = ranges_[r * len_ + len_ - 1] = 0;
-            std::fill(ranges_.end() - static_cast<std::ptrdiff_t>(len_), ranges_.end(), 0.0f);
-        }
-        float* row(std::int64_t j, std::int64_t k) noexcept
-        {
-            return &ranges_[(static_cast<std::size_t>(k & 1) * static_cast<std::size_t>(ny_) + static_cast<std::size_t>(j)) * len_];
-        }
-        const float* zero() const noexcept { return &ranges_[2 * static_cast<std::size_t>(ny_) * len_]; }
-
-    private:
-        std::size_t len_;
-        std::int64_t ny_;
-        Buffer<float> ranges_; // not zeroed: see above
-    };
-
-    /// The cell rows around sample row (j, k) in CellRangeRows: below[b] is cell row (j - 1 + b,
-    /// k - 1), here[b] (j - 1 + b, k). `first_plane`: k is the range's first plane and not the
-    /// grid's: the cells below are the previous range's, so its x and y edge vertices take
-    /// edge_cell_range() instead.
-    struct CellsAround {
-        const float* below[2];
-        const float* here[2];
-        bool first_plane;
-        /// The value of the vertex on the edge from sample i along `axis`: the largest range of
-        /// the cells around the edge, (i, j - 1 .. j, k - 1 .. k) for x, (i - 1 .. i, j,
-        /// k - 1 .. k) for y, (i - 1 .. i, j - 1 .. j, k) for z.
-        template <int axis> float value(std::int64_t i) const noexcept
-        {
-            const auto c = static_cast<std::size_t>(i); // cell i - 1 at c, cell i at c + 1
-            if constexpr (axis == 0) {
-                return std::max(std::max(below[0][c + 1], below[1][c + 1]), std::max(here[0][c + 1], here[1][c + 1]));
-            } else if constexpr (axis == 1) {
-                return std::max(std::max(below[1][c], below[1][c + 1]), std::max(here[1][c], here[1][c + 1]));
-            } else {
-                return std::max(std::max(here[0][c], here[0][c + 1]), std::max(here[1][c], here[1][c + 1]));
-            }
-        }
-    };
 
     /// One range's emit: its counts, offsets and output.
     struct Emit {
@@ -161,6 +106,8 @@ private:
         const RangeOffsets& off;
         const MeshSpans& out;
         double gradient_scale;
+        /// MeshSpans::vertex_cell_ranges' hook (cell_ranges.hpp); null without that output.
+        VertexCellRanges<T>* ranges;
         /// One past the range's last triangle id: a short tiling's fixed-size copy may write past
         /// its row's triangles into those of the range's next rows, which this thread writes
         /// later, but not past the range's (another thread's, or the end of the caller's output).
@@ -176,7 +123,6 @@ private:
         SliceMasks masks;
         IdRows ids;
         detail::RowScan scan;
-        std::optional<CellRangeRows> ranges; ///< with MeshSpans::vertex_cell_ranges
     };
 
     /// The range-relative ids of row (j, k) of a range: x/y edge vertices [xy0, xy1), z edge and
@@ -191,16 +137,6 @@ private:
     /// output, chosen once per range). Returns false when the ticker stopped it.
     template <Outputs kOut>
     bool emit_planes(const Emit& e, Scratch& s, Ticker* ticker, std::size_t& decision) const;
-
-    /// The cell rows around sample row (j, k) (CellsAround) in s.ranges.
-    CellsAround cells_around(std::int64_t j, std::int64_t k, Scratch& s, const Emit& e) const;
-
-    /// cell_range() of the crossed cells of cell row (j, k) into its CellRangeRows row: where x
-    /// is the array's contiguous axis, 8 cells at a time from the first crossed cell not yet
-    /// done, in a loop the compiler vectorizes (a group may reach into the next word's cells,
-    /// which that word computes again); else, and for the row's last cells, cell by cell.
-    /// Unaligned groups of 8 measured best (docs/performance.md, "Python").
-    void write_cell_ranges(std::int64_t j, std::int64_t k, const RowSpan& r, Scratch& s) const;
 
     T at(std::int64_t i, std::int64_t j, std::int64_t k) const { return g_.data[g_.offset(i, j, k)]; }
 
@@ -307,18 +243,6 @@ private:
         out[2 - first] = p[2];
     }
 
-    /// Samples widened so that differences of two are exact: int64 for integer types, double else.
-    using Exact = std::conditional_t<std::is_integral_v<T>, std::int64_t, double>;
-
-    /// Largest minus smallest of the 8 samples of cell (i, j, k).
-    Exact cell_range(std::int64_t i, std::int64_t j, std::int64_t k) const { return cell_range(g_.data + g_.offset(i, j, k)); }
-    /// ... of the cell whose lowest corner sample is at p: pairs, then a tree, no branch.
-    CMC33_ALWAYS_INLINE Exact cell_range(const T* p) const;
-
-    /// MeshSpans::vertex_cell_ranges of the vertex on the edge from sample (i, j, k) along `axis`:
-    /// the largest cell_range() of the (up to four) cells around the edge.
-    float edge_cell_range(std::int64_t i, std::int64_t j, std::int64_t k, int axis) const;
-
     /// A power of two that keeps every scaled gradient, and its interpolation between two samples,
     /// finite: 1 unless the samples or the map to world gradients are near the double range.
     /// (Scaling by a power of two is exact, so ranges with different bounds give the same normals.)
@@ -345,19 +269,18 @@ private:
     /// says.
     template <Outputs kOut>
     void emit_row_vertices(std::int64_t j, std::int64_t k, const RowSpan& r, const Word* const (&rows)[4],
-                           const std::uint32_t* ids, Scratch& s, const Emit& e) const;
+                           const std::uint32_t* ids, const Emit& e) const;
 
     /// The vertices of the crossed edges along `axis` of samples 64 w + b of row (j, k), b a bit of
     /// `crossed`.
     template <int axis, Outputs kOut>
     CMC33_ALWAYS_INLINE void emit_axis_vertices(Word crossed, std::int64_t w, std::int64_t j, std::int64_t k,
-                                                const std::uint32_t* ids, const CellsAround& cells, const Emit& e) const;
+                                                const std::uint32_t* ids, const Emit& e) const;
 
-    /// The vertex `id` on the edge from sample (i, j, k) along `axis`; `cells` (CellsAround) only
-    /// with vertex_cell_ranges.
+    /// The vertex `id` on the edge from sample (i, j, k) along `axis`.
     template <int axis, Outputs kOut>
     CMC33_ALWAYS_INLINE void emit_edge_vertex(std::int64_t i, std::int64_t j, std::int64_t k, std::uint32_t id,
-                                              const CellsAround& cells, const Emit& e) const;
+                                              const Emit& e) const;
 
     /// Normals point from above to below: along minus the world gradient. `zyx` as in write_position.
     /// False (and (0, 0, 0) written) where g is 0: the caller then falls back to another gradient.

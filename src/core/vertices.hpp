@@ -298,7 +298,7 @@ void RangeExtractor<T>::write_interior_vertices(std::int64_t i, std::int64_t j, 
         }
         if (out.vertex_edges) out.vertex_edges[v] = -1 - whole_cell(i, j, k);
         if (out.vertex_parameters) out.vertex_parameters[v] = -1.0f;
-        if (out.vertex_cell_ranges) out.vertex_cell_ranges[v] = static_cast<float>(cell_range(i, j, k));
+        if (e.ranges) e.ranges->interior_vertex(v, i, j, k);
         if (out.vertex_values) {
             double f = 0;
             for (int c = 0; c < 8; ++c) f += w[c] * static_cast<double>(value[c]);

@@ -261,9 +261,9 @@ template <class T> std::vector<T> typed_noise(cmc33::Index3 dims, std::uint64_t 
 TEST(Passes, TheDropInsOutputIsTheExtrasRangesAndPositionsInZyx)
 {
     // cmc33.marching_cubes's outputs (positions and normals in (z, y, x), vertex_cell_ranges and
-    // nothing else) take their own code in emit: the same numbers as with every extra, which
-    // check_extras checks, for 8-, 16- and 32-bit and float samples, rows long enough for emit's
-    // groups of 8 cells and their ends, and views whose x is not the contiguous axis
+    // nothing else): the same numbers as with every extra, which check_extras checks, for 8-,
+    // 16- and 32-bit and float samples, rows long enough for the cell ranges' groups of 8 cells
+    // and their ends, and views whose x is not the contiguous axis
     std::int64_t interior = 0;
     const auto check = [&](auto tag, double iso) {
         using T = decltype(tag);
