@@ -15,6 +15,10 @@
 
 #include <CLI/CLI.hpp>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "cmc33/error.hpp"
 #include "cmc33/mesh.hpp"
 #include "cmc33/version.hpp"
@@ -26,6 +30,20 @@ namespace {
 
 constexpr int kExitFailure = 1;
 constexpr int kExitUsage = 2;
+
+/// glibc's malloc keeps what the tool frees for its next step instead of unmapping it: blocks up
+/// to 32 MiB (its largest mmap threshold) come from the heap, and freed heap memory is not
+/// trimmed, so that the check, the writers and the label surfaces reuse pages the extraction
+/// touched rather than fault in fresh ones (costly on a VM, the more so where a balloon takes
+/// free pages back). Blocks over 16 MiB of meshes are Buffer's (src/base/buffer.cpp) and keep
+/// their own cache; the slab engine still trims after each slab (--memory-limit).
+void keep_freed_memory()
+{
+#if defined(__GLIBC__)
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+#endif
+}
 
 /// One line: messages from files may hold newlines (a quoted header line), the contract is one line.
 std::string one_line(std::string message)
@@ -110,6 +128,7 @@ DashFile dash_file(CLI::App& app, const std::vector<std::string>& args)
 int main(int argc, char** argv)
 {
     cmc33::cli::install_signal_cleanup(); // first: every thread started later inherits its signal mask
+    keep_freed_memory();
     // a new huge page costs more than it saves where the VM's balloon takes free memory back
     cmc33::set_huge_page_advice(!cmc33::detail::balloon_reports_free_memory());
     CLI::App app("cmc33 " CMC33_VERSION_STRING ": extracts a topologically correct, manifold isosurface mesh\n"
