@@ -217,14 +217,22 @@ struct Slice {
     }
 };
 
+/// A code or UID from the file as it is when it is one short printable word (RGB, CT, 1.2.840...),
+/// else quoted with its odd bytes escaped: a message stays one line whatever the file holds.
+std::string shown(const std::string& value)
+{
+    const bool plain = value.size() <= 64 && std::all_of(value.begin(), value.end(), [](unsigned char c) { return c > 0x20 && c < 0x7f; });
+    return plain ? value : quote_bytes(value, 64);
+}
+
 std::string series_summary(const std::vector<const Header*>& files)
 {
     const Header& h = *files.front();
     std::int64_t slices = 0;
     for (const Header* f : files) slices += f->frames;
-    std::string s = h.series.empty() ? std::string("(no SeriesInstanceUID)") : h.series;
+    std::string s = h.series.empty() ? std::string("(no SeriesInstanceUID)") : shown(h.series);
     s += " (";
-    if (!h.modality.empty()) s += h.modality + " ";
+    if (!h.modality.empty()) s += shown(h.modality) + " ";
     if (!h.description.empty()) s += quote_bytes(h.description, 64) + " ";
     s += str_cat(h.columns, "x", h.rows, "x", slices, ")");
     return s;
@@ -287,7 +295,8 @@ void check_uniform(const std::vector<const Header*>& files, const std::string& l
         }
         if (f->samples_per_pixel != 1) {
             throw Error(Status::unsupported_format,
-                        str_cat(f->label, ": ", f->samples_per_pixel, " samples per pixel (", f->photometric.empty() ? "color" : f->photometric,
+                        str_cat(f->label, ": ", f->samples_per_pixel, " samples per pixel (",
+                                f->photometric.empty() ? "color" : shown(f->photometric),
                                 "); expected one sample per pixel (MONOCHROME1 or MONOCHROME2), a scalar volume"));
         }
         // PALETTE COLOR indices are no scalar, and GDCM's decoders assert on an unknown value (none: read as MONOCHROME2)
