@@ -8,7 +8,9 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -32,6 +34,7 @@ struct LabelsArgs {
     std::string labels = "all";
     std::int64_t background = 0;
     std::string format = "ply";
+    std::string label_names;
     bool json = false;
     bool normals = false;
     int threads = 0;
@@ -56,6 +59,55 @@ std::array<float, 4> label_colour(std::size_t n)
     return out;
 }
 
+/// sRGB (a colour table's, a segmentation's) to linear, as glTF's baseColorFactor is linear.
+float linear_from_srgb(double srgb)
+{
+    // IEC 61966-2-1
+    return static_cast<float>(srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4));
+}
+
+/// The part of a name that goes into a file name: letters, digits, '-', '_' and '.', every other
+/// run of characters one '_', at most 64 characters.
+std::string file_name_part(const std::string& name)
+{
+    std::string out;
+    for (const char c : name) {
+        const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' ||
+                          c == '_' || c == '.';
+        if (keep) {
+            out += c;
+        } else if (!out.empty() && out.back() != '_') {
+            out += '_';
+        }
+        if (out.size() == 64) break;
+    }
+    while (!out.empty() && (out.back() == '_' || out.back() == '.')) out.pop_back();
+    while (!out.empty() && out.front() == '.') out.erase(out.begin());
+    return out;
+}
+
+/// An sRGB colour as JSON, each channel to 6 decimals (a float's digits, not its binary tail).
+Json rgb_json(const std::array<float, 3>& rgb)
+{
+    Json out = Json::array();
+    for (const float c : rgb) out.push_back(std::round(static_cast<double>(c) * 1e6) / 1e6);
+    return out;
+}
+
+/// The labels' names and colours: the volume's own (a 3D Slicer .seg.nrrd), then --label-names's,
+/// which win where both name a value.
+std::map<std::int64_t, io::LabelName> label_names(const LabelsArgs& args)
+{
+    std::map<std::int64_t, io::LabelName> names;
+    if (!args.raw.any_given()) {
+        for (io::LabelName& n : io::read_segment_names(args.input)) names[n.value] = std::move(n);
+    }
+    if (!args.label_names.empty()) {
+        for (io::LabelName& n : io::read_colour_table(args.label_names)) names[n.value] = std::move(n);
+    }
+    return names;
+}
+
 void run_labels(const LabelsArgs& args)
 {
     LabelOptions options;
@@ -74,13 +126,23 @@ void run_labels(const LabelsArgs& args)
         check_mesh_output(args.output, false, args.normals, {args.input});
     } else {
         // a folder, made if missing (its parent must exist); every file is named label_<value>.<format>
-        const fs::path folder(args.output);
+        fs::path folder(args.output);
+        if (folder.filename().empty()) folder = folder.parent_path(); // "meshes/" is the folder meshes
         const bool exists = fs::is_directory(folder);
         if (!exists && fs::exists(folder)) throw UsageError("-o " + args.output + ": not a folder or a .ply file");
         const fs::path where = exists ? folder : (folder.parent_path().empty() ? fs::path(".") : folder.parent_path());
         check_mesh_output((where / ("label_0." + args.format)).string(), false, args.normals, {args.input});
     }
+    const std::map<std::int64_t, io::LabelName> names = label_names(args);
     const Volume volume = load_volume(args.input, args.raw);
+    const auto name_of = [&](std::int64_t value) {
+        const auto it = names.find(value);
+        return it == names.end() ? std::string() : it->second.name;
+    };
+    const auto colour_of = [&](std::int64_t value) -> std::optional<std::array<float, 3>> {
+        const auto it = names.find(value);
+        return it == names.end() ? std::nullopt : it->second.colour;
+    };
     const LabelSurfaces s =
         named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
 
@@ -90,8 +152,15 @@ void run_labels(const LabelsArgs& args)
         meshes.reserve(s.selected.size());
         std::vector<io::ScenePart> parts;
         for (const std::int64_t value : s.selected) meshes.push_back(label_surface(s, value));
-        for (std::size_t i = 0; i < meshes.size(); ++i)
-            parts.push_back({&meshes[i], "label_" + std::to_string(s.selected[i]), label_colour(i)});
+        for (std::size_t i = 0; i < meshes.size(); ++i) {
+            const std::int64_t value = s.selected[i];
+            std::array<float, 4> colour = label_colour(i);
+            if (const auto c = colour_of(value)) {
+                for (std::size_t k = 0; k < 3; ++k) colour[k] = linear_from_srgb((*c)[k]);
+            }
+            const std::string name = name_of(value);
+            parts.push_back({&meshes[i], name.empty() ? "label_" + std::to_string(value) : name, colour});
+        }
         io::MeshWriteOptions wo;
         wo.space = volume.space();
         named_step(args.output, "writing the scene", [&] { io::write_scene(parts, args.output, wo); });
@@ -113,7 +182,11 @@ void run_labels(const LabelsArgs& args)
         const Mesh m = label_surface(s, value);
         std::string file = scene ? args.output : std::string();
         if (!single) {
-            file = (fs::path(args.output) / ("label_" + std::to_string(value) + "." + args.format)).string();
+            // label_<value>.<format>, or label_<value>_<name>.<format> for a named label
+            const std::string name = file_name_part(name_of(value));
+            file = (fs::path(args.output) /
+                    ("label_" + std::to_string(value) + (name.empty() ? "" : "_" + name) + "." + args.format))
+                       .string();
             io::MeshWriteOptions wo;
             wo.space = volume.space();
             named_step(file, "writing a label's surface", [&] { io::write_mesh(m, file, wo); });
@@ -121,7 +194,11 @@ void run_labels(const LabelsArgs& args)
         if (args.json) {
             const MeshTopology t = mesh_topology(m);
             const MeshGeometry g = mesh_geometry(m, geometry_options);
+            const std::string name = name_of(value);
+            const auto colour = colour_of(value);
             labels.push_back(Json{{"value", value},
+                                  {"name", name.empty() ? Json(nullptr) : Json(name)},
+                                  {"color", colour ? rgb_json(*colour) : Json(nullptr)},
                                   {"file", file.empty() ? Json(nullptr) : Json(file)},
                                   {"vertices", static_cast<std::int64_t>(m.vertex_count())},
                                   {"triangles", static_cast<std::int64_t>(m.triangle_count())},
@@ -160,9 +237,9 @@ void add_labels(CLI::App& app)
         ->required()
         ->check(non_empty("a volume file"));
     cmd->add_option("-o,--output", args->output,
-                    "A folder (one file per label, label_<value>.<format>; made if missing), a .ply of the "
-                    "interface triangles with face properties front and behind, or a .glb/.gltf scene with a "
-                    "mesh per label, named label_<value>, each in its own colour")
+                    "A folder (one file per label, label_<value>.<format> or label_<value>_<name>.<format>; made "
+                    "if missing), a .ply of the interface triangles with face properties front and behind, or a "
+                    ".glb/.gltf scene with a mesh per label, named by its name or label_<value>, in its colour")
         ->required()
         ->type_name("OUT")
         ->check(non_empty("an output folder, .ply, .glb or .gltf file"));
@@ -178,7 +255,14 @@ void add_labels(CLI::App& app)
     cmd->add_flag("--normals", args->normals,
                   "Per-vertex normals: each label's pointing out of it, the interfaces' to the front label "
                   "(area-weighted triangle normals; not in .off or .stl)");
-    cmd->add_flag("--json", args->json, "Print one JSON object: every label's file, size, topology and embedding");
+    cmd->add_option("--label-names", args->label_names,
+                    "A colour table naming the labels: lines \"value name R G B [A]\" (3D Slicer .ctbl/.txt, "
+                    "FreeSurfer LUT) or ITK-SNAP's label descriptions; a .seg.nrrd's own segment names are read "
+                    "without it, and it wins where both name a label")
+        ->type_name("FILE")
+        ->check(non_empty("a colour table file"));
+    cmd->add_flag("--json", args->json,
+                  "Print one JSON object: every label's name, colour, file, size, topology and embedding");
     cmd->add_option("--threads", args->threads,
                     "Threads of the surfaces and the --json checks, 0 = all cores (the same files for any count)")
         ->type_name("N")
@@ -195,7 +279,8 @@ void add_labels(CLI::App& app)
                 "  cmc33 labels seg.nrrd -o meshes/ --json\n"
                 "  cmc33 labels seg.nrrd -o meshes/ --labels 1,3-5 --format stl\n"
                 "  cmc33 labels seg.nrrd -o interfaces.ply\n"
-                "  cmc33 labels seg.nrrd -o organs.glb --normals");
+                "  cmc33 labels seg.nrrd -o organs.glb --normals\n"
+                "  cmc33 labels aseg.nii.gz -o regions/ --label-names FreeSurferColorLUT.txt");
     cmd->callback([args] { run_labels(*args); });
 }
 

@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
@@ -57,13 +59,27 @@ inline void check_mesh(const Mesh& m)
     }
 }
 
-/// Runs `read` (which returns a Volume or a Mesh); an Error must carry a proper message.
+inline void check_label_names(const std::vector<io::LabelName>& names)
+{
+    std::set<std::int64_t> values;
+    for (const io::LabelName& n : names) {
+        if (!values.insert(n.value).second) bug("a label value named twice", std::to_string(n.value));
+        if (!n.colour) continue;
+        for (const float c : *n.colour) {
+            if (!(c >= 0 && c <= 1)) bug("a colour channel outside [0, 1]", std::to_string(c));
+        }
+    }
+}
+
+/// Runs `read` (which returns a Volume, a Mesh or label names); an Error must carry a proper message.
 template <class Read> int run(const std::string& label, Read&& read)
 {
     try {
         auto result = std::forward<Read>(read)();
         if constexpr (std::is_same_v<decltype(result), Volume>) {
             check_volume(result);
+        } else if constexpr (std::is_same_v<decltype(result), std::vector<io::LabelName>>) {
+            check_label_names(result);
         } else {
             check_mesh(result);
         }

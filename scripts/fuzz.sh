@@ -5,8 +5,9 @@
 # crashed, leaked, hung or ran out of memory. Crash inputs are kept in build-fuzz/fuzz-work/.
 #
 # Usage: scripts/fuzz.sh [SECONDS] [TARGET...]   targets: nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff
-#   nifti npy vti. The build reads DICOM through GDCM where it is installed (fuzz_dicom fuzzes the
-#   code around it; without GDCM every DICOM input is refused and the target fuzzes little).
+#   nifti npy vti labelnames (colour tables and .seg.nrrd segment names). The build reads DICOM
+#   through GDCM where it is installed (fuzz_dicom fuzzes the code around it; without GDCM every
+#   DICOM input is refused and the target fuzzes little).
 # Environment: FUZZ_RUNS=N stops each target after N executions instead (SECONDS then caps the
 # time); FUZZ_NO_BUILD=1 skips the build (for running several instances side by side).
 set -euo pipefail
@@ -17,7 +18,7 @@ if [[ $# -gt 0 && "$1" =~ ^[0-9]+$ ]]; then
     seconds=$1
     shift
 fi
-all=(nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff nifti npy vti)
+all=(nrrd nhdr mha mhd vtk raw ply obj stl off dicom tiff nifti npy vti labelnames)
 targets=("$@")
 [[ ${#targets[@]} -eq 0 ]] && targets=("${all[@]}")
 for t in "${targets[@]}"; do

@@ -28,6 +28,7 @@ CMC33_FUZZ_HARNESS(tiff)
 CMC33_FUZZ_HARNESS(nifti)
 CMC33_FUZZ_HARNESS(npy)
 CMC33_FUZZ_HARNESS(vti)
+CMC33_FUZZ_HARNESS(labelnames)
 #undef CMC33_FUZZ_HARNESS
 
 namespace {
@@ -63,5 +64,6 @@ TEST(FuzzCorpus, Tiff) { replay("tiff", cmc33_fuzz_tiff); }
 TEST(FuzzCorpus, Nifti) { replay("nifti", cmc33_fuzz_nifti); }
 TEST(FuzzCorpus, Npy) { replay("npy", cmc33_fuzz_npy); }
 TEST(FuzzCorpus, Vti) { replay("vti", cmc33_fuzz_vti); }
+TEST(FuzzCorpus, LabelNames) { replay("labelnames", cmc33_fuzz_labelnames); }
 
 } // namespace

@@ -11,6 +11,8 @@
 #include <sys/wait.h>
 #include <utility>
 
+#include <nlohmann/json.hpp>
+
 #include "cmc33/io.hpp"
 #include "cmc33/labels.hpp"
 #include "cmc33/topology.hpp"
@@ -159,6 +161,58 @@ TEST(LabelsCli, BadInput)
     EXPECT_EQ(run("labels " + (dir / "two.nrrd").string() + " -o " + (dir / "o.glb").string(), dir / "err"), 0)
         << test::read_file(dir / "err");
     EXPECT_TRUE(fs::exists(dir / "o.glb"));
+}
+
+// Names and colours: a 3D Slicer .seg.nrrd's segments name the files, the scene's meshes and the
+// JSON's labels; --label-names's table wins where both name a label; a bad table is refused in
+// one line before any work, nothing written.
+TEST(LabelsCli, NamesAndColoursFromTheSegmentationAndATable)
+{
+    const fs::path dir = test::temp_dir();
+    const Volume seg = label_checks::random_labels(8, 3, 11, true);
+    io::write_volume(seg, dir / "plain.nrrd");
+    std::string nrrd = test::read_file(dir / "plain.nrrd");
+    const std::size_t blank = nrrd.find("\n\n");
+    ASSERT_NE(blank, std::string::npos);
+    nrrd.insert(blank + 1, "Segment0_Color:=1 0.5 0\nSegment0_LabelValue:=1\nSegment0_Layer:=0\n"
+                           "Segment0_Name:=Left kidney\nSegment1_LabelValue:=3\nSegment1_Name:=Tumour/mass\n");
+    test::write_file(dir / "s.seg.nrrd", nrrd);
+    test::write_file(dir / "lut.txt", "# value name R G B A\n3 Lesion 0 0 255 0\n");
+    const std::string input = (dir / "s.seg.nrrd").string();
+
+    // a folder given with a trailing separator is made, as without
+    ASSERT_EQ(run("labels " + input + " -o " + (dir / "out").string() + "/", dir / "err"), 0)
+        << test::read_file(dir / "err");
+    EXPECT_TRUE(fs::exists(dir / "out" / "label_1_Left_kidney.ply"));
+    EXPECT_TRUE(fs::exists(dir / "out" / "label_2.ply"));
+    EXPECT_TRUE(fs::exists(dir / "out" / "label_3_Tumour_mass.ply"));
+
+    ASSERT_EQ(std::system((std::string(CMC33_EXE) + " labels " + input + " -o " + (dir / "s.glb").string() +
+                           " --label-names " + (dir / "lut.txt").string() + " --json >" + (dir / "j").string())
+                              .c_str()),
+              0);
+    const nlohmann::json j = nlohmann::json::parse(test::read_file(dir / "j"));
+    ASSERT_EQ(j["labels"].size(), 3u);
+    EXPECT_EQ(j["labels"][0]["name"], "Left kidney");
+    EXPECT_EQ(j["labels"][0]["color"], nlohmann::json({1.0, 0.5, 0.0}));
+    EXPECT_TRUE(j["labels"][1]["name"].is_null());
+    EXPECT_TRUE(j["labels"][1]["color"].is_null());
+    EXPECT_EQ(j["labels"][2]["name"], "Lesion"); // the table's, over the file's
+    EXPECT_EQ(j["labels"][2]["color"], nlohmann::json({0.0, 0.0, 1.0}));
+    const std::string glb = test::read_file(dir / "s.glb");
+    EXPECT_NE(glb.find("\"name\":\"Left kidney\""), std::string::npos);
+    EXPECT_NE(glb.find("\"name\":\"label_2\""), std::string::npos);
+    // sRGB 0.5 is linear 0.21404114 in glTF's baseColorFactor
+    EXPECT_NE(glb.find("\"baseColorFactor\":[1,0.21404114,0,1]"), std::string::npos) << glb.substr(0, 2000);
+
+    test::write_file(dir / "bad.txt", "1 Liver\n2 Spleen 0 0\n");
+    EXPECT_EQ(run("labels " + input + " -o " + (dir / "o2").string() + " --label-names " + (dir / "bad.txt").string(),
+                  dir / "err"),
+              1);
+    const std::string err = test::read_file(dir / "err");
+    EXPECT_NE(err.find("bad.txt: line 2 \"2 Spleen 0 0\" has 4 words"), std::string::npos) << err;
+    EXPECT_EQ(err.find('\n'), err.size() - 1) << err;
+    EXPECT_FALSE(fs::exists(dir / "o2"));
 }
 
 } // namespace

@@ -15,6 +15,7 @@
 /// a half-written file behind.
 
 #include <array>
+#include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -152,6 +153,29 @@ CMC33_IO_EXPORT void write_scene(const std::vector<ScenePart>& parts, const std:
 /// with more than three vertices are fanned. STL has no indices: exactly coincident vertices are
 /// welded. @throws Error.
 CMC33_IO_EXPORT Mesh read_mesh(const std::filesystem::path& path);
+
+/// A label's name and display colour (a label map's, for the meshes of its labels).
+struct LabelName {
+    std::int64_t value = 0;
+    std::string name{};                          ///< may be empty: a colour without a name
+    std::optional<std::array<float, 3>> colour{}; ///< sRGB, each channel from 0 to 1
+};
+
+/// The segments a 3D Slicer segmentation's NRRD header names (.seg.nrrd: SegmentN_Name,
+/// SegmentN_Color, SegmentN_LabelValue, SegmentN_Layer), those of layer 0 with a label value; none
+/// for a file that is not NRRD (or not a file) or has no segments. Reads the header only. @throws Error for a
+/// segment field that is not what Slicer writes, or two segments of one value.
+CMC33_IO_EXPORT std::vector<LabelName> read_segment_names(const std::filesystem::path& volume);
+/// read_segment_names() of a header in memory; `label` names it in messages.
+CMC33_IO_EXPORT std::vector<LabelName> parse_segment_names(std::string_view header, const std::string& label);
+
+/// A colour table: lines "value name [R G B [A]]" (3D Slicer's .ctbl/.txt, FreeSurfer's LUT;
+/// channels 0-255, the name one word or in double quotes) or ITK-SNAP's label descriptions
+/// "value R G B A visible mesh \"name\"" (A from 0 to 1); blank lines and "#" comments skipped.
+/// @throws Error naming the line that is neither, a value named twice, or a table without labels.
+CMC33_IO_EXPORT std::vector<LabelName> read_colour_table(const std::filesystem::path& table);
+/// read_colour_table() of text in memory; `label` names it in messages.
+CMC33_IO_EXPORT std::vector<LabelName> parse_colour_table(std::string_view text, const std::string& label);
 
 /// A volume format, for bytes that have no file name to tell it.
 enum class VolumeFormat {
