@@ -156,7 +156,7 @@ void run_labels(const LabelsArgs& args)
             const std::int64_t value = s.selected[i];
             std::array<float, 4> colour = label_colour(i);
             if (const auto c = colour_of(value)) {
-                for (std::size_t k = 0; k < 3; ++k) colour[k] = linear_from_srgb((*c)[k]);
+                for (std::size_t k = 0; k < 3; ++k) colour[k] = linear_from_srgb(static_cast<double>((*c)[k]));
             }
             const std::string name = name_of(value);
             parts.push_back({&meshes[i], name.empty() ? "label_" + std::to_string(value) : name, colour});
