@@ -41,6 +41,13 @@ struct LabelsArgs {
     RawVolumeOptions raw;
 };
 
+/// sRGB to linear, as glTF's baseColorFactor is linear.
+float linear_from_srgb(double srgb)
+{
+    // IEC 61966-2-1
+    return static_cast<float>(srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4));
+}
+
 /// The colour of the n-th label of a scene: hues a golden angle apart (so that neighbours in the
 /// list differ), saturation 0.6, value 0.9, as linear RGBA.
 std::array<float, 4> label_colour(std::size_t n)
@@ -50,20 +57,8 @@ std::array<float, 4> label_colour(std::size_t n)
     const int sector = static_cast<int>(h) % 6;
     const double rgb[6][3] = {{c, x, 0}, {x, c, 0}, {0, c, x}, {0, x, c}, {x, 0, c}, {c, 0, x}};
     std::array<float, 4> out{0, 0, 0, 1};
-    for (std::size_t k = 0; k < 3; ++k) {
-        const double srgb = rgb[sector][k] + m;
-        // sRGB to linear (IEC 61966-2-1), as glTF's baseColorFactor is linear
-        const double linear = srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4);
-        out[k] = static_cast<float>(linear);
-    }
+    for (std::size_t k = 0; k < 3; ++k) out[k] = linear_from_srgb(rgb[sector][k] + m);
     return out;
-}
-
-/// sRGB (a colour table's, a segmentation's) to linear, as glTF's baseColorFactor is linear.
-float linear_from_srgb(double srgb)
-{
-    // IEC 61966-2-1
-    return static_cast<float>(srgb <= 0.04045 ? srgb / 12.92 : std::pow((srgb + 0.055) / 1.055, 2.4));
 }
 
 /// The part of a name that goes into a file name: letters, digits, '-', '_' and '.', every other
