@@ -120,7 +120,7 @@ void run_labels(const LabelsArgs& args)
     if (single) {
         check_mesh_output(args.output, false, args.normals, {args.input});
     } else {
-        // a folder, made if missing (its parent must exist); every file is named label_<value>.<format>
+        // a folder, made if missing (its parent must exist), of files label_<value>[_<name>].<format>
         fs::path folder(args.output);
         if (folder.filename().empty()) folder = folder.parent_path(); // "meshes/" is the folder meshes
         const bool exists = fs::is_directory(folder);

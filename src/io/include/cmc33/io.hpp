@@ -163,8 +163,8 @@ struct LabelName {
 
 /// The segments a 3D Slicer segmentation's NRRD header names (.seg.nrrd: SegmentN_Name,
 /// SegmentN_Color, SegmentN_LabelValue, SegmentN_Layer), those of layer 0 with a label value; none
-/// for a file that is not NRRD (or not a file) or has no segments. Reads the header only. @throws Error for a
-/// segment field that is not what Slicer writes, or two segments of one value.
+/// for a file that is not NRRD (or not a file) or has no segments. Reads the header only.
+/// @throws Error for a segment field that is not what Slicer writes, or two segments of one value.
 CMC33_IO_EXPORT std::vector<LabelName> read_segment_names(const std::filesystem::path& volume);
 /// read_segment_names() of a header in memory; `label` names it in messages.
 CMC33_IO_EXPORT std::vector<LabelName> parse_segment_names(std::string_view header, const std::string& label);
