@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -31,21 +30,17 @@ using detail::trim;
 /// Colour tables and headers larger than this are refused (FreeSurfer's full table is 0.1 MiB).
 constexpr std::size_t kMaxTableBytes = std::size_t{16} << 20;
 
+/// The readers' integer and number parsers (volume_formats.hpp), as optionals; numbers finite.
 std::optional<std::int64_t> parse_integer(std::string_view text)
 {
     std::int64_t value = 0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty()) return std::nullopt;
-    return value;
+    return detail::parse_integer(text, value) ? std::optional(value) : std::nullopt;
 }
 
 std::optional<double> parse_number(std::string_view text)
 {
     double value = 0;
-    const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (ec != std::errc() || end != text.data() + text.size() || text.empty() || !std::isfinite(value))
-        return std::nullopt;
-    return value;
+    return detail::parse_real(text, value) && std::isfinite(value) ? std::optional(value) : std::nullopt;
 }
 
 /// The lines of `text` (LF or CR LF).
