@@ -21,8 +21,10 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <exception>
 #include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <utility>
@@ -49,6 +51,7 @@ bool boxes_meet(const Box& a, const Box& b)
 struct Placed {
     std::int64_t cell;     ///< j * (nx - 1) + i
     std::int64_t triangle; ///< index into LayeredTriangles::triangles
+    std::array<std::uint32_t, 3> ids; ///< its corners' vertex ids
     Box box;
     bool proper;
     /// Whether its corners lie in its cell's closed box (axis-aligned frames only); then `on[v]`
@@ -105,10 +108,18 @@ void for_each_block(std::int64_t blocks, int threads, const std::function<void(s
     std::atomic<std::int64_t> next{0};
     std::atomic<std::int64_t> finished{0};
     std::atomic<bool> stop{false};
+    // the calling thread waits for the last block on this, not by polling: a sleep's latency
+    // would be paid at the end of every check
+    std::mutex waiting;
+    std::condition_variable woken;
+    const auto wake = [&] {
+        const std::lock_guard<std::mutex> lock(waiting);
+        woken.notify_all();
+    };
     const auto take = [&] {
         for (std::int64_t b; !stop.load(std::memory_order_relaxed) && (b = next++) < blocks;) {
             body(b, stop);
-            ++finished;
+            if (++finished == blocks) wake();
         }
     };
     const int helpers = static_cast<int>(std::min<std::int64_t>(threads, blocks)) - 1;
@@ -121,6 +132,7 @@ void for_each_block(std::int64_t blocks, int threads, const std::function<void(s
             } catch (...) {
                 errors[static_cast<std::size_t>(t) + 1] = std::current_exception();
                 stop = true;
+                wake();
             }
         });
     }
@@ -136,7 +148,11 @@ void for_each_block(std::int64_t blocks, int threads, const std::function<void(s
             }
         }
         while (!stop.load() && finished.load() < blocks) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(10));
+            {
+                std::unique_lock<std::mutex> lock(waiting);
+                woken.wait_for(lock, std::chrono::milliseconds(10),
+                               [&] { return stop.load() || finished.load() >= blocks; });
+            }
             if (!tick()) {
                 cancelled = true;
                 stop = true;
@@ -216,25 +232,33 @@ private:
         }
     }
 
-    Point3 position(std::uint32_t v) const
+    /// point() of vertex v, checked: an id among the positions, finite coordinates.
+    CMC33_ALWAYS_INLINE Point3 position(std::uint32_t v) const
     {
         const std::int64_t local = static_cast<std::int64_t>(v) - m_.first_vertex;
-        if (local < 0 || static_cast<std::size_t>(3 * local + 2) >= m_.positions.size()) {
-            throw Error(Status::invalid_argument, "grid_geometry: vertex " + std::to_string(v) + " is not among the " +
-                                                      std::to_string(m_.positions.size() / 3) + " positions given");
-        }
+        if (local < 0 || static_cast<std::size_t>(3 * local + 2) >= m_.positions.size()) [[unlikely]]
+            refuse_vertex(v, false);
         const float* p = &m_.positions[static_cast<std::size_t>(3 * local)];
-        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) {
+        if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) [[unlikely]]
+            refuse_vertex(v, true);
+        return point(v);
+    }
+
+    /// position()'s errors, out of the loop that calls it.
+    [[noreturn]] CMC33_NOINLINE void refuse_vertex(std::uint32_t v, bool not_finite) const
+    {
+        if (not_finite) {
             throw Error(Status::invalid_argument, "grid_geometry: vertex " + std::to_string(v) +
                                                       " has a coordinate that is not a finite number");
         }
-        // + 0.0 turns -0 into +0, as mesh_geometry() welds them
-        return {static_cast<double>(p[0]) + 0.0, static_cast<double>(p[1]) + 0.0, static_cast<double>(p[2]) + 0.0};
+        throw Error(Status::invalid_argument, "grid_geometry: vertex " + std::to_string(v) + " is not among the " +
+                                                  std::to_string(m_.positions.size() / 3) + " positions given");
     }
 
-    /// position() of a vertex that build() has already checked.
+    /// The position of a vertex that build() has already checked.
     Point3 point(std::uint32_t v) const
     {
+        // + 0.0 turns -0 into +0, as mesh_geometry() welds them
         const float* p = &m_.positions[static_cast<std::size_t>(3 * (static_cast<std::int64_t>(v) - m_.first_vertex))];
         return {static_cast<double>(p[0]) + 0.0, static_cast<double>(p[1]) + 0.0, static_cast<double>(p[2]) + 0.0};
     }
@@ -289,7 +313,9 @@ private:
                       std::array<std::uint8_t, 3>& on) const
     {
         const std::int64_t cell[3] = {i, j, k};
-        on = {};
+        unsigned bits[3] = {0, 0, 0};
+        bool in = true;
+        // without branches on the comparisons, whose outcomes follow no pattern
         for (std::size_t a = 0; a < 3; ++a) {
             const auto at = static_cast<std::size_t>(cell[a]);
             if (at + 1 >= planes_[a].size()) return false;
@@ -297,12 +323,12 @@ private:
             const double lo = low < high ? low : high, hi = low < high ? high : low; // both finite
             for (std::size_t v = 0; v < 3; ++v) {
                 const double x = p[v][a];
-                if (!(x >= lo && x <= hi)) return false;
-                if (x == low) on[v] = static_cast<std::uint8_t>(on[v] | 1u << (2 * a));
-                if (x == high) on[v] = static_cast<std::uint8_t>(on[v] | 1u << (2 * a + 1));
+                in &= (x >= lo) & (x <= hi);
+                bits[v] |= static_cast<unsigned>(x == low) << (2 * a) | static_cast<unsigned>(x == high) << (2 * a + 1);
             }
         }
-        return true;
+        for (std::size_t v = 0; v < 3; ++v) on[v] = static_cast<std::uint8_t>(bits[v]);
+        return in;
     }
 
     /// Layer z's triangles (z relative to k0), placed in their cells; counts strays, coincident
@@ -325,15 +351,28 @@ private:
                 cy += q[v][1];
             }
             const std::int64_t ci = cell_at(cx / 3, cells_x_), cj = cell_at(cy / 3, cells_y_);
-            const double lo[3] = {static_cast<double>(ci) - kCellMargin, static_cast<double>(cj) - kCellMargin, kz - kCellMargin};
-            bool inside = true;
-            for (int v = 0; v < 3; ++v)
-                for (std::size_t a = 0; a < 3; ++a) {
-                    // NaN-safe: a corner that compares false is outside
-                    if (!(q[v][a] >= lo[a] && q[v][a] <= lo[a] + 1 + 2 * kCellMargin)) inside = false;
-                }
+            // written in place: a copy built on the stack field by field and then stored whole
+            // stalls on every triangle (its wide loads wait for the narrow stores)
+            Placed& e = layer.placed.emplace_back();
+            e.cell = cj * cells_x_ + ci;
+            e.triangle = t;
+            e.ids = {c[0], c[1], c[2]};
+            if (axis_aligned_) e.boxed = place_in_box(p, ci, cj, m_.k0 + z, e.on);
+            if (e.boxed) e.touches = kContactsOf[e.on[0]] | kContactsOf[e.on[1]] | kContactsOf[e.on[2]];
+            // a triangle in its cell's box is within the margin too
+            bool inside = e.boxed;
+            if (!inside) {
+                const double lo[3] = {static_cast<double>(ci) - kCellMargin, static_cast<double>(cj) - kCellMargin,
+                                      kz - kCellMargin};
+                inside = true;
+                for (int v = 0; v < 3; ++v)
+                    for (std::size_t a = 0; a < 3; ++a) {
+                        // NaN-safe: a corner that compares false is outside
+                        if (!(q[v][a] >= lo[a] && q[v][a] <= lo[a] + 1 + 2 * kCellMargin)) inside = false;
+                    }
+            }
             const bool repeated = c[0] == c[1] || c[1] == c[2] || c[0] == c[2];
-            const bool proper = !repeated && !collinear(p[0], p[1], p[2]);
+            e.proper = !repeated && !collinear(p[0], p[1], p[2]);
             if (own) {
                 if (!inside) ++out.strays;
                 // distinct ids at one position, in a collapsed triangle too
@@ -341,16 +380,8 @@ private:
                     const auto a = static_cast<std::size_t>(v), b = static_cast<std::size_t>((v + 1) % 3);
                     if (c[a] != c[b] && p[a] == p[b]) ++out.coincident;
                 }
-                if (!proper) ++out.zero_area_triangles;
+                if (!e.proper) ++out.zero_area_triangles;
             }
-            // written in place: a copy built on the stack field by field and then stored whole
-            // stalls on every triangle (its wide loads wait for the narrow stores)
-            Placed& e = layer.placed.emplace_back();
-            e.cell = cj * cells_x_ + ci;
-            e.triangle = t;
-            e.proper = proper;
-            if (axis_aligned_) e.boxed = place_in_box(p, ci, cj, m_.k0 + z, e.on);
-            if (e.boxed) e.touches = kContactsOf[e.on[0]] | kContactsOf[e.on[1]] | kContactsOf[e.on[2]];
             for (std::size_t a = 0; a < 3; ++a) {
                 // the doubles hold floats exactly
                 e.box.lo[a] = static_cast<float>(std::min({p[0][a], p[1][a], p[2][a]}));
@@ -377,30 +408,59 @@ private:
         std::fill(start + filled, start + cells + 1, static_cast<std::uint32_t>(layer.placed.size()));
     }
 
-    /// Tests the pair (a, b) of triangles of neighbouring cells, b's cell at an offset from a's
-    /// whose contact is faces `need_a` of a's cell and `need_b` of b's (contact_faces); counts
-    /// what it finds into `out`.
-    void test_neighbours(const Placed& a, const Placed& b, unsigned need_a, unsigned need_b, GridGeometry& out) const
+    /// The corners of a boxed triangle that lie on a contact (faces `need` of its cell): the hull
+    /// of their points is where it meets the contact. n = -1 for a triangle that is not boxed.
+    struct Trace {
+        std::uint32_t ids[3];
+        int n;
+    };
+    static constexpr std::size_t kTracedGroup = 16;
+
+    void trace(const Placed& p, unsigned need, Trace& t) const
     {
-        if (!a.boxed || !b.boxed) return test_pair(a, b, out);
-        std::uint32_t trace_a[3], trace_b[3];
-        int na = 0, nb = 0;
-        const std::uint32_t* a_ids = corners(a.triangle);
-        const std::uint32_t* b_ids = corners(b.triangle);
-        for (std::size_t v = 0; v < 3; ++v) {
-            if ((a.on[v] & need_a) == need_a) trace_a[na++] = a_ids[v];
-            if ((b.on[v] & need_b) == need_b) trace_b[nb++] = b_ids[v];
+        t.n = -1;
+        if (!p.boxed) return;
+        t.n = 0;
+        for (std::size_t v = 0; v < 3; ++v) { // without branches, as in place_in_box()
+            t.ids[t.n] = p.ids[v];
+            t.n += (p.on[v] & need) == need ? 1 : 0;
         }
-        if (na == 0 || nb == 0) return; // the boxes meet only in the contact: disjoint
-        // corners of each trace whose id the other has (a collapsed triangle repeats an id)
-        int a_in_b = 0, b_in_a = 0;
-        for (int x = 0; x < na; ++x) a_in_b += std::find(trace_b, trace_b + nb, trace_a[x]) != trace_b + nb ? 1 : 0;
-        for (int y = 0; y < nb; ++y) b_in_a += std::find(trace_a, trace_a + na, trace_b[y]) != trace_a + na ? 1 : 0;
+    }
+
+    /// Whether every id of x is one of y's.
+    static bool within(const Trace& x, const Trace& y)
+    {
+        for (int u = 0; u < x.n; ++u) {
+            const std::uint32_t id = x.ids[u];
+            bool found = false;
+            for (int w = 0; w < y.n; ++w) found = found || y.ids[w] == id;
+            if (!found) return false;
+        }
+        return true;
+    }
+
+    /// test_neighbours()'s first decisions on two boxed triangles' traces: a pair with an empty
+    /// trace is disjoint, and one whose trace lies within the other's meets in what they share.
+    static bool settled(const Trace& a, const Trace& b)
+    {
+        if (a.n < 0 || b.n < 0) return false;
+        return a.n == 0 || b.n == 0 || within(a, b) || within(b, a);
+    }
+
+    /// Tests the pair (a, b) of triangles of neighbouring cells, given their traces on the contact
+    /// of their cells (trace()); counts what it finds into `out`.
+    void test_neighbours(const Placed& a, const Placed& b, const Trace& ta, const Trace& tb, GridGeometry& out) const
+    {
+        if (ta.n < 0 || tb.n < 0) return test_pair(a, b, out);
         // a trace within the other: the pair meets in the hull of what it shares. Distinct ids at
         // one position lie in the contact, hence in both traces: here both in one triangle, which
         // build() counts
-        if (a_in_b == na || b_in_a == nb) return;
-        const int common = a_in_b; // proper triangles below: no id repeated
+        if (settled(ta, tb)) return;
+        const int na = ta.n, nb = tb.n;
+        const std::uint32_t* trace_a = ta.ids;
+        const std::uint32_t* trace_b = tb.ids;
+        int common = 0; // proper triangles below: no id repeated
+        for (int x = 0; x < na; ++x) common += std::find(trace_b, trace_b + nb, trace_a[x]) != trace_b + nb ? 1 : 0;
         for (int x = 0; x < na; ++x)
             for (int y = 0; y < nb; ++y)
                 if (trace_a[x] != trace_b[y] && point(trace_a[x]) == point(trace_b[y])) ++out.coincident;
@@ -425,8 +485,8 @@ private:
     CMC33_NOINLINE void test_pair(const Placed& a, const Placed& b, GridGeometry& out, bool count_coincident = true) const
     {
         if (!boxes_meet(a.box, b.box)) return;
-        const std::uint32_t* a_ids = corners(a.triangle);
-        const std::uint32_t* b_ids = corners(b.triangle);
+        const std::uint32_t* a_ids = a.ids.data();
+        const std::uint32_t* b_ids = b.ids.data();
         const std::array<Point3, 3> a_points{point(a_ids[0]), point(a_ids[1]), point(a_ids[2])};
         const std::array<Point3, 3> b_points{point(b_ids[0]), point(b_ids[1]), point(b_ids[2])};
         // corners of b that a has too (by id), and distinct ids at one position
@@ -494,10 +554,20 @@ private:
                 if ((group_touches & bit_a) == 0) return;
                 const unsigned need_a = contact_faces(di, dj, dk), need_b = contact_faces(-di, -dj, -dk);
                 const auto range = cell_of(layer, i + di, j + dj);
+                // the group's traces once, not once per pair: most pairs are settled by them
+                const bool traced = h - g <= kTracedGroup;
+                Trace traces[kTracedGroup], ta, tb;
+                if (traced)
+                    for (std::size_t a = g; a < h; ++a) trace(placed[a], need_a, traces[a - g]);
                 for (const Placed* b = range.first; b != range.second; ++b) {
                     if ((b->touches & bit_b) == 0) continue;
-                    for (std::size_t a = g; a < h; ++a)
-                        if ((placed[a].touches & bit_a) != 0) test_neighbours(placed[a], *b, need_a, need_b, out);
+                    trace(*b, need_b, tb);
+                    for (std::size_t a = g; a < h; ++a) {
+                        if ((placed[a].touches & bit_a) == 0) continue;
+                        if (!traced) trace(placed[a], need_a, ta);
+                        const Trace& x = traced ? traces[a - g] : ta;
+                        if (!settled(x, tb)) test_neighbours(placed[a], *b, x, tb, out);
+                    }
                 }
             };
             for (std::size_t a = g; a < h; ++a)
