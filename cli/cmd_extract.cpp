@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -93,6 +94,21 @@ void run_extract(const ExtractArgs& args)
     MeshTopology topology;
     MeshGeometry geometry;
     bool structured = false;
+    const io::MeshWriteOptions write_options{args.ascii, offset, volume.space()};
+    const auto write = [&](const Mesh& m, const io::MeshWriteOptions& o) {
+        named_step(args.output, "writing the mesh", [&] { io::write_mesh(m, args.output, o); });
+    };
+    // Without mesh steps the file does not depend on the check: it is written while the check
+    // runs, and replaces OUT only once the check has finished. If the check fails, `checked` is
+    // destroyed unset before `written` (declared first) waits for the writer, which then throws
+    // and leaves OUT as it was.
+    std::future<void> written;
+    std::promise<void> checked;
+    if (!args.output.empty() && !args.steps.any()) {
+        io::MeshWriteOptions o = write_options;
+        o.before_commit = [done = checked.get_future().share()] { done.get(); };
+        written = std::async(std::launch::async, [&write, &mesh, o] { write(mesh, o); });
+    }
     if (!args.no_topology) {
         // with the grid's structure (extract()'s layout of planes), slab by slab in parallel
         ExtractedGrid grid{volume.dims(), volume.spacing(), volume.origin(), volume.direction(),
@@ -113,16 +129,16 @@ void run_extract(const ExtractArgs& args)
         geometry = check.geometry;
         structured = check.structured;
     }
+    if (written.valid()) {
+        checked.set_value();
+        written.get();
+    }
     // the steps of `cmc33 simplify`, from what the check found; the mesh written is their result
     std::optional<MeshStepsResult> steps;
     if (args.steps.any()) {
         steps = run_mesh_steps(mesh, args.steps, StepsContext{args.input, args.progress, args.quiet, args.threads},
                                &topology, &geometry);
-    }
-    const Mesh& written = steps ? steps->mesh : mesh;
-    if (!args.output.empty()) {
-        named_step(args.output, "writing the mesh",
-                   [&] { io::write_mesh(written, args.output, io::MeshWriteOptions{args.ascii, offset, volume.space()}); });
+        if (!args.output.empty()) write(steps->mesh, write_options);
     }
     if (offset) volume.set_origin(*offset);
 

@@ -554,13 +554,19 @@ void write_gltf(const std::filesystem::path& path, const std::vector<detail::Glt
         // disk always finds its whole buffer.
         std::filesystem::path bin = path;
         bin.replace_extension(".bin");
-        detail::write_atomically(bin, [&](std::ostream& out) { detail::write_gltf_bin(parts, out); });
+        detail::write_atomically(bin, [&](std::ostream& out) {
+            detail::write_gltf_bin(parts, out);
+            if (options.before_commit) options.before_commit();
+        });
         detail::write_atomically(path, [&](std::ostream& out) {
             detail::write_gltf_json(parts, out, options, bin.filename().string());
         });
         return;
     }
-    detail::write_atomically(path, [&](std::ostream& out) { detail::write_glb(parts, out, options, path.string()); });
+    detail::write_atomically(path, [&](std::ostream& out) {
+        detail::write_glb(parts, out, options, path.string());
+        if (options.before_commit) options.before_commit();
+    });
 }
 
 } // namespace
@@ -630,6 +636,7 @@ void write_mesh(const Mesh& mesh, const std::filesystem::path& path,
         } else {
             detail::write_off(mesh, out, offset);
         }
+        if (options.before_commit) options.before_commit();
     });
 }
 

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -309,6 +310,50 @@ TEST(MeshIo, OverwritesAnExistingFile)
     mesh.triangles = {0, 1, 2};
     cmc33::io::write_mesh(mesh, path);
     EXPECT_EQ(cmc33::test::read_file(path), "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+}
+
+TEST(MeshIo, BeforeCommitRunsOnceTheBytesAreWrittenAndItsErrorLeavesEveryFileAsItWas)
+{
+    const fs::path dir = cmc33::test::temp_dir();
+    const Mesh mesh = test_cube(true);
+    // every kind of writer: the common one, .glb, and .gltf with its .bin
+    for (const char* name : {"m.ply", "m.stl", "m.vtp", "m.gii", "m.glb", "m.gltf"}) {
+        SCOPED_TRACE(name);
+        const fs::path path = dir / name;
+        fs::path bin = path;
+        bin.replace_extension(".bin");
+        const bool gltf = path.extension() == ".gltf";
+        cmc33::test::write_file(path, "old");
+        if (gltf) cmc33::test::write_file(bin, "old bin");
+        cmc33::io::MeshWriteOptions refused;
+        int calls = 0;
+        refused.before_commit = [&] {
+            ++calls;
+            // the bytes are written by now, beside the target and not over it
+            EXPECT_EQ(cmc33::test::read_file(path), "old");
+            throw Error(Status::cancelled, "the check was cancelled");
+        };
+        expect_error([&] { cmc33::io::write_mesh(mesh, path, refused); }, Status::cancelled, "the check was cancelled");
+        EXPECT_EQ(calls, 1);
+        EXPECT_EQ(cmc33::test::read_file(path), "old");
+        if (gltf) {
+            EXPECT_EQ(cmc33::test::read_file(bin), "old bin");
+        }
+
+        cmc33::io::MeshWriteOptions allowed;
+        allowed.before_commit = [&] { ++calls; };
+        cmc33::io::write_mesh(mesh, path, allowed);
+        EXPECT_EQ(calls, 2);
+        EXPECT_NE(cmc33::test::read_file(path), "old");
+        if (gltf) {
+            EXPECT_NE(cmc33::test::read_file(bin), "old bin");
+        }
+    }
+    // no temporary is left behind
+    std::vector<std::string> names;
+    for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, (std::vector<std::string>{"m.bin", "m.gii", "m.glb", "m.gltf", "m.ply", "m.stl", "m.vtp"}));
 }
 
 } // namespace

@@ -127,6 +127,10 @@ struct MeshWriteOptions {
     std::vector<MeshArray> vertex_arrays{}; ///< .vtp point data (e.g. the values at the vertices)
     /// .vtp cell data, .ply face properties (e.g. a label per triangle)
     std::vector<MeshArray> triangle_arrays{};
+    /// Optional: called once all bytes are written, before they replace the file (for .gltf,
+    /// before its .bin does). An exception from it leaves every file as it was and propagates:
+    /// a caller can write while it still computes something the file must wait for.
+    std::function<void()> before_commit{};
 };
 
 /// Writes .ply, .obj, .stl (binary), .off, .glb, .gltf (+ a .bin of the same stem beside it),
