@@ -2,7 +2,9 @@
 // shared (src/labels, docs/labels.md): a folder of one closed surface per label, or one PLY of
 // interface triangles with the labels on their two sides.
 
+#include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
@@ -18,9 +20,11 @@
 #include "cmc33/error.hpp"
 #include "cmc33/io.hpp"
 #include "cmc33/labels.hpp"
+#include "cmc33/threads.hpp"
 #include "cmc33/topology.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "parallel.hpp"
 #include "plural.hpp"
 
 namespace cmc33::cli {
@@ -141,12 +145,18 @@ void run_labels(const LabelsArgs& args)
     const LabelSurfaces s =
         named_step(args.input, "making the label surfaces", [&] { return label_surfaces(volume, options); });
 
-    Json labels = Json::array();
+    std::vector<Mesh> meshes; // the scene's, one per selected label
     if (scene) {
-        std::vector<Mesh> meshes;
-        meshes.reserve(s.selected.size());
+        meshes.resize(s.selected.size());
+        detail::parallel_chunks(static_cast<std::int64_t>(meshes.size()),
+                                detail::threads_for(args.threads, static_cast<std::int64_t>(meshes.size())),
+                                [&](int, std::int64_t begin, std::int64_t end) {
+                                    for (std::int64_t i = begin; i < end; ++i) {
+                                        const auto at = static_cast<std::size_t>(i);
+                                        meshes[at] = label_surface(s, s.selected[at]);
+                                    }
+                                });
         std::vector<io::ScenePart> parts;
-        for (const std::int64_t value : s.selected) meshes.push_back(label_surface(s, value));
         for (std::size_t i = 0; i < meshes.size(); ++i) {
             const std::int64_t value = s.selected[i];
             std::array<float, 4> colour = label_colour(i);
@@ -171,10 +181,13 @@ void run_labels(const LabelsArgs& args)
         fs::create_directory(args.output, ec);
         if (ec) throw Error(Status::io_error, args.output + ": cannot make the folder (" + ec.message() + ")");
     }
-    MeshGeometryOptions geometry_options;
-    geometry_options.threads = args.threads;
-    for (const std::int64_t value : s.selected) {
-        const Mesh m = label_surface(s, value);
+    // Each label's file (a folder) and --json entry. A folder's labels are made, written and dropped
+    // on all threads, a label to a thread at a time; the scene's meshes are reused; the interfaces'
+    // .ply needs a label's surface only for --json.
+    const std::size_t count = s.selected.size();
+    std::vector<Json> entries(count);
+    const auto one_label = [&](std::size_t i, const Mesh& m, int check_threads) {
+        const std::int64_t value = s.selected[i];
         std::string file = scene ? args.output : std::string();
         if (!single) {
             // label_<value>.<format>, or label_<value>_<name>.<format> for a named label
@@ -186,22 +199,47 @@ void run_labels(const LabelsArgs& args)
             wo.space = volume.space();
             named_step(file, "writing a label's surface", [&] { io::write_mesh(m, file, wo); });
         }
-        if (args.json) {
-            const MeshTopology t = mesh_topology(m);
-            const MeshGeometry g = mesh_geometry(m, geometry_options);
-            const std::string name = name_of(value);
-            const auto colour = colour_of(value);
-            labels.push_back(Json{{"value", value},
-                                  {"name", name.empty() ? Json(nullptr) : Json(name)},
-                                  {"color", colour ? rgb_json(*colour) : Json(nullptr)},
-                                  {"file", file.empty() ? Json(nullptr) : Json(file)},
-                                  {"vertices", static_cast<std::int64_t>(m.vertex_count())},
-                                  {"triangles", static_cast<std::int64_t>(m.triangle_count())},
-                                  {"topology", topology_json(t)},
-                                  {"embedded", g.embedded()},
-                                  {"geometry", geometry_json(g)}});
-        }
+        if (!args.json) return;
+        const MeshTopology t = mesh_topology(m);
+        MeshGeometryOptions geometry_options;
+        geometry_options.threads = check_threads;
+        const MeshGeometry g = mesh_geometry(m, geometry_options);
+        const std::string name = name_of(value);
+        const auto colour = colour_of(value);
+        entries[i] = Json{{"value", value},
+                          {"name", name.empty() ? Json(nullptr) : Json(name)},
+                          {"color", colour ? rgb_json(*colour) : Json(nullptr)},
+                          {"file", file.empty() ? Json(nullptr) : Json(file)},
+                          {"vertices", static_cast<std::int64_t>(m.vertex_count())},
+                          {"triangles", static_cast<std::int64_t>(m.triangle_count())},
+                          {"topology", topology_json(t)},
+                          {"embedded", g.embedded()},
+                          {"geometry", geometry_json(g)}};
+    };
+    if (scene) {
+        for (std::size_t i = 0; i < count && args.json; ++i) one_label(i, meshes[i], args.threads);
+    } else if (single) {
+        for (std::size_t i = 0; i < count && args.json; ++i) one_label(i, label_surface(s, s.selected[i]), args.threads);
+    } else {
+        const int workers = detail::threads_for(args.threads, static_cast<std::int64_t>(count));
+        // the checks' threads shared among the labels made at once
+        const int check_threads = std::max(1, cmc33::thread_count(args.threads) / workers);
+        std::atomic<bool> failed{false};
+        detail::parallel_chunks(static_cast<std::int64_t>(count), workers, [&](int, std::int64_t begin, std::int64_t end) {
+            for (std::int64_t i = begin; i < end && !failed; ++i) {
+                try {
+                    one_label(static_cast<std::size_t>(i), label_surface(s, s.selected[static_cast<std::size_t>(i)]),
+                              check_threads);
+                } catch (...) {
+                    failed = true;
+                    throw;
+                }
+            }
+        });
     }
+    Json labels = Json::array();
+    for (Json& e : entries)
+        if (!e.is_null()) labels.push_back(std::move(e));
     if (args.json) {
         Json present = Json::array();
         for (const std::int64_t v : s.present) present.push_back(v);
