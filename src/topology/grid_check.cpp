@@ -448,14 +448,12 @@ private:
     }
 
     /// Tests the pair (a, b) of triangles of neighbouring cells, given their traces on the contact
-    /// of their cells (trace()); counts what it finds into `out`.
+    /// of their cells (trace()); counts what it finds into `out`. Its caller has passed over the
+    /// settled pairs (settled(): a trace within the other meets in the hull of what it shares;
+    /// distinct ids at one position lie in both traces, in one triangle, which build() counts).
     void test_neighbours(const Placed& a, const Placed& b, const Trace& ta, const Trace& tb, GridGeometry& out) const
     {
         if (ta.n < 0 || tb.n < 0) return test_pair(a, b, out);
-        // a trace within the other: the pair meets in the hull of what it shares. Distinct ids at
-        // one position lie in the contact, hence in both traces: here both in one triangle, which
-        // build() counts
-        if (settled(ta, tb)) return;
         const int na = ta.n, nb = tb.n;
         const std::uint32_t* trace_a = ta.ids;
         const std::uint32_t* trace_b = tb.ids;
