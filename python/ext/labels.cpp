@@ -26,7 +26,7 @@ struct Labelled {
 
 py::tuple label_surfaces_py(const py::array& labels, const Vec3& spacing, const Vec3& origin, const Mat3& direction,
                             std::int64_t background, const LabelRanges& selection, bool normals, int threads,
-                            bool per_label)
+                            bool per_label, double smooth)
 {
     const Samples s = samples_of(labels, "labels");
     LabelOptions options;
@@ -34,6 +34,7 @@ py::tuple label_surfaces_py(const py::array& labels, const Vec3& spacing, const 
     options.labels = selection;
     options.normals = normals;
     options.threads = threads;
+    options.smooth = smooth;
     const Frame frame{spacing, origin, direction};
     Labelled out = run_interruptible<Labelled>(false, py::none(), [&](Control&) {
         Labelled l;
@@ -61,7 +62,7 @@ void bind_labels(py::module_& m)
 {
     m.def("label_surfaces", &label_surfaces_py, py::arg("labels"), py::arg("spacing"), py::arg("origin"),
           py::arg("direction"), py::arg("background"), py::arg("selection"), py::arg("normals"), py::arg("threads"),
-          py::arg("per_label"));
+          py::arg("per_label"), py::arg("smooth") = 0.0);
     m.def("parse_label_ranges", [](const std::string& text) { return parse_label_ranges(text); }, py::arg("text"));
 }
 

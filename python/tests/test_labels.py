@@ -186,3 +186,52 @@ def test_the_gil_is_released_while_the_library_works():
     assert result["seconds"] > 0.3, "the work was too short to tell"
     # with the GIL held this thread would have stood still for the whole run
     assert largest_gap < min(0.25, result["seconds"] / 2), (largest_gap, result["seconds"])
+
+
+def filtered_indicator(labels, label, sigma):
+    """The indicator of `label` filtered as docs/labels.md says: Gaussian taps to ceil(3 sigma),
+    renormalised to the samples inside the array, along each axis in turn (written here with numpy)."""
+    r = int(np.ceil(3 * sigma))
+    taps = np.exp(-0.5 * (np.arange(-r, r + 1) / sigma) ** 2)
+    f = (labels == label).astype(np.float64)
+    for axis in range(3):
+        ones = np.ones(f.shape[axis])
+        weights = np.convolve(ones, taps, mode="same")
+        f = np.apply_along_axis(lambda line: np.convolve(line, taps, mode="same"), axis, f)
+        shape = [1, 1, 1]
+        shape[axis] = -1
+        f = f / weights.reshape(shape)
+    return f.astype(np.float32)
+
+
+def test_smooth_labels_are_the_command_lines_and_the_filtered_level_set(cli, tmp_path):
+    labels = three_classes()
+    path = tmp_path / "seg.nrrd"
+    cmc33.write_volume(labels, path)
+    subprocess.run([str(cli), "labels", str(path), "-o", str(tmp_path / "out"), "--smooth", "1.5"], check=True,
+                   capture_output=True)
+    result = cmc33.label_surfaces(labels, smooth=1.5)
+    plain = cmc33.label_surfaces(labels)
+    for label, mesh in result.surfaces.items():
+        theirs = cmc33.read_mesh(tmp_path / "out" / f"label_{label}.ply")
+        assert np.array_equal(mesh.vertices, theirs.vertices), label
+        assert np.array_equal(mesh.triangles, theirs.triangles), label
+        assert cmc33.mesh_geometry(mesh).embedded, label
+        assert not np.array_equal(mesh.vertices, plain.surfaces[label].vertices), label
+    # two labels: the interface is the level set 0.5 of the lower label's filtered indicator
+    two = (uint8_blobs((24, 26, 28)) > 128).astype(np.uint8)
+    f = filtered_indicator(two, 0, 1.2)
+    assert np.abs(f - 0.5).min() > 1e-5  # no sample within rounding of the tie
+    surface = cmc33.label_surfaces(two, smooth=1.2, background=1).surfaces[0]
+    want = cmc33.field_topology(f, 0.5)
+    got = cmc33.mesh_topology(surface)
+    assert want.determined
+    assert (got.euler, got.components, got.b1, got.closed_components, got.boundary_loops) == \
+        (want.euler, want.b0, want.b1, want.b2, want.boundary_loops)
+    assert len(surface.triangles) == len(cmc33.extract(f, 0.5).triangles)
+
+
+@pytest.mark.parametrize("smooth, message", [(-1, "smooth"), (float("nan"), "smooth"), ("1", "smooth"), (True, "smooth")])
+def test_bad_smooth_is_refused(smooth, message):
+    with pytest.raises(ValueError, match=message):
+        cmc33.label_surfaces(three_classes(), smooth=smooth)

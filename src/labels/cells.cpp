@@ -68,7 +68,7 @@ template <std::size_t N> int root_of(const std::array<int, N>& parent, int x)
 
 } // namespace
 
-FaceCut cut_faces(const std::array<std::int64_t, 8>& label)
+FaceCut cut_faces(const std::array<std::int64_t, 8>& label, const DiagonalRule* rule)
 {
     FaceCut cut;
     std::array<int, 8> parent{0, 1, 2, 3, 4, 5, 6, 7};
@@ -111,7 +111,9 @@ FaceCut cut_faces(const std::array<std::int64_t, 8>& label)
             // diagonals are alike, cmc33's tie rule): the other corners are cut off
             const bool diagonal0 = l[0] == l[2], diagonal1 = l[1] == l[3];
             if (diagonal0 || diagonal1) {
-                const std::int64_t joined = diagonal0 && diagonal1 ? sorted[0] : (diagonal0 ? l[0] : l[1]);
+                const std::int64_t joined = diagonal0 && diagonal1
+                                                ? (rule != nullptr ? (*rule)(q, sorted[0], sorted[1]) : sorted[0])
+                                                : (diagonal0 ? l[0] : l[1]);
                 Piece& whole = piece();
                 whole.label = joined;
                 for (unsigned i = 0; i < 4; ++i) {

@@ -6,6 +6,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -98,8 +99,14 @@ struct FaceCut {
     std::array<int, 8> corner_root{}; ///< corners joined along uncut edges and joined diagonals
 };
 
+/// Which of a face's two labels low < high, one on each diagonal, is joined across it, given the
+/// face's corners in cyclic order: the lower one without a rule (cmc33's tie), and with smoothed
+/// labels the one cmc33 joins on their values.
+using DiagonalRule =
+    std::function<std::int64_t(const std::array<unsigned, 4>& corners, std::int64_t low, std::int64_t high)>;
+
 /// The face curves and pieces of the cell with these corner labels (x fastest, then y, then z).
-FaceCut cut_faces(const std::array<std::int64_t, 8>& label);
+FaceCut cut_faces(const std::array<std::int64_t, 8>& label, const DiagonalRule* rule = nullptr);
 
 /// The label whose part of the cell's surface is not one disk (more than one piece, or one piece
 /// with more than one boundary loop), the lowest such; none when every label's part is a disk.
@@ -113,9 +120,10 @@ std::optional<std::int64_t> core_label(const std::array<std::int64_t, 8>& label,
 // between it and the core: a quad per segment (two triangles) between neighbouring frustums, and
 // the core's faces under the other labels' pieces (fans from a corner).
 // Returns whether the cell took a core.
-template <class Emit> bool many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit)
+template <class Emit>
+bool many_label_cell(const std::array<std::int64_t, 8>& label, Emit&& emit, const DiagonalRule* rule = nullptr)
 {
-    const FaceCut cut = cut_faces(label);
+    const FaceCut cut = cut_faces(label, rule);
     // front is the side the winding's normal points to; `probe` is a point on near's side
     const auto oriented = [&](const Quad& a, const Quad& b, const Quad& c, const Quad& probe, std::int64_t near,
                               std::int64_t far) {

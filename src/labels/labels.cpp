@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <unordered_set>
@@ -17,9 +18,11 @@
 #include <vector>
 
 #include "cells.hpp"
+#include "cmc33/cell.hpp"
 #include "cmc33/error.hpp"
 #include "parallel.hpp"
 #include "sample_types.hpp"
+#include "smooth.hpp"
 
 namespace cmc33 {
 
@@ -97,8 +100,10 @@ template <class T> std::vector<std::int64_t> scan_present(const GridView<T>& g)
 // cmc33's interior points belong to one cell and are numbered within it.
 template <class T> class Worker {
 public:
-    Worker(const GridView<T>& g, const Placer& place, const Chooser& chosen, Part& out)
-        : g_(g), place_(place), chosen_(chosen), flip_(place.mirrors()), out_(out),
+    /// With `smooth`, g is its label map and the crossings and tied faces follow its values.
+    Worker(const GridView<T>& g, const Placer& place, const Chooser& chosen, Part& out,
+           const label_smooth::Smoothed<T>* smooth = nullptr)
+        : g_(g), place_(place), chosen_(chosen), smooth_(smooth), flip_(place.mirrors()), out_(out),
           span0_(static_cast<std::size_t>(2 * g.nx() - 1))
     {
         const std::size_t plane = span0_ * static_cast<std::size_t>(2 * g.ny() - 1);
@@ -169,6 +174,7 @@ private:
         if (two) {
             ++out_.cells_two_labels;
             if (!chosen_.wanted(low, high)) return;
+            if (smooth_ != nullptr) return smooth_two_labels(low, high, i, j, k);
             unsigned config = 0;
             for (unsigned c = 0; c < 8; ++c) config |= (label[c] == low ? 1U : 0U) << c;
             std::array<std::uint32_t, kInteriorSlots> interior;
@@ -201,15 +207,39 @@ private:
             // a corner of the cell's core: the cell's own
             std::uint32_t& id = core[static_cast<std::size_t>((q[0] - 1) + 3 * (q[1] - 1) + 9 * (q[2] - 1))];
             if (id == kNone) {
-                id = new_vertex(static_cast<double>(i) + 0.25 * q[0], static_cast<double>(j) + 0.25 * q[1],
-                                static_cast<double>(k) + 0.25 * q[2]);
+                // halfway from the centre to the point of the cell's surface it is the image of
+                const Doubled from{q[0] - 1, q[1] - 1, q[2] - 1};
+                std::array<double, 3> p{0.25 * q[0], 0.25 * q[1], 0.25 * q[2]};
+                if (smooth_ != nullptr && odd_count(from) == 1) {
+                    const std::size_t axis = from[0] == 1 ? 0 : (from[1] == 1 ? 1 : 2);
+                    p[axis] = 0.25 + 0.5 * edge_t(2 * i + from[0], 2 * j + from[1], 2 * k + from[2], axis);
+                }
+                id = new_vertex(static_cast<double>(i) + p[0], static_cast<double>(j) + p[1],
+                                static_cast<double>(k) + p[2]);
             }
             return id;
         };
+        // with smoothing, a face of two labels on its diagonals joins the pair cmc33 joins on the
+        // values (the two-label cell beside it decides so)
+        DiagonalRule rule; // empty without smoothing: nothing allocated per cell
+        if (smooth_ != nullptr)
+            rule = [&](const std::array<unsigned, 4>& q, std::int64_t lo, std::int64_t hi) {
+                std::array<double, 4> v{};
+                for (std::size_t c = 0; c < 4; ++c) {
+                    v[c] = smooth_->difference(lo, hi, i + (q[c] & 1U), j + (q[c] >> 1 & 1U), k + (q[c] >> 2 & 1U));
+                }
+                // the bilinear saddle's sign against 0: products of floats are exact in double, and a
+                // difference of doubles is 0 only when they are equal
+                const bool lo_on_diagonal0 = v[0] >= 0;
+                const double joined_lo = lo_on_diagonal0 ? v[0] * v[2] - v[1] * v[3] : v[1] * v[3] - v[0] * v[2];
+                return joined_lo >= 0 ? lo : hi;
+            };
         const bool took_core = many_label_cell(
-            label, [&](const Quad& a, const Quad& b, const Quad& c, std::int64_t front, std::int64_t behind) {
+            label,
+            [&](const Quad& a, const Quad& b, const Quad& c, std::int64_t front, std::int64_t behind) {
                 if (chosen_.wanted(front, behind)) add({vertex(a), vertex(b), vertex(c)}, front, behind);
-            });
+            },
+            smooth_ != nullptr ? &rule : nullptr);
         if (took_core) ++out_.cells_with_core;
     }
 
@@ -232,10 +262,69 @@ private:
         const std::size_t at = static_cast<std::size_t>(x) + span0_ * static_cast<std::size_t>(y);
         std::uint32_t& id = planes_[plane][at];
         if (id == kNone) {
-            id = new_vertex(0.5 * static_cast<double>(x), 0.5 * static_cast<double>(y), 0.5 * static_cast<double>(z));
+            std::array<double, 3> p{0.5 * static_cast<double>(x), 0.5 * static_cast<double>(y),
+                                    0.5 * static_cast<double>(z)};
+            const Doubled d{static_cast<int>(x & 1), static_cast<int>(y & 1), static_cast<int>(z & 1)};
+            if (smooth_ != nullptr && odd_count(d) == 1) {
+                const std::size_t axis = d[0] == 1 ? 0 : (d[1] == 1 ? 1 : 2);
+                p[axis] = std::floor(p[axis]) + edge_t(x, y, z, axis);
+            }
+            id = new_vertex(p[0], p[1], p[2]);
             touched_[plane].push_back(static_cast<std::uint32_t>(at));
         }
         return id;
+    }
+
+    static int odd_count(const Doubled& d) { return (d[0] & 1) + (d[1] & 1) + (d[2] & 1); }
+
+    // Where f_low - f_high of the edge's two labels is 0 on the edge at doubled coordinates
+    // (x, y, z) along `axis`, from its lower end: linear along the edge as cmc33 places a crossing,
+    // and at least 2^-10 of the edge from either end as cmc33 keeps it (docs/conventions.md).
+    double edge_t(std::int64_t x, std::int64_t y, std::int64_t z, std::size_t axis) const
+    {
+        std::array<std::int64_t, 3> p{x / 2, y / 2, z / 2}, q = p;
+        ++q[axis];
+        const auto a = static_cast<std::int64_t>(g_(p[0], p[1], p[2])),
+                   b = static_cast<std::int64_t>(g_(q[0], q[1], q[2]));
+        const std::int64_t lo = std::min(a, b), hi = std::max(a, b);
+        const double vp = smooth_->difference(lo, hi, p[0], p[1], p[2]),
+                     vq = smooth_->difference(lo, hi, q[0], q[1], q[2]);
+        constexpr double delta = 1.0 / 1024;
+        return std::clamp(vp / (vp - vq), delta, 1 - delta);
+    }
+
+    // A cell of two labels with smoothing: cmc33's triangulation of f_low - f_high at 0 (corners of
+    // the lower label above), its crossings on the cell's edges shared with the neighbours.
+    void smooth_two_labels(std::int64_t low, std::int64_t high, std::int64_t i, std::int64_t j, std::int64_t k)
+    {
+        std::array<double, 8> values{};
+        for (unsigned c = 0; c < 8; ++c) {
+            values[c] = smooth_->difference(low, high, i + (c & 1U), j + (c >> 1 & 1U), k + (c >> 2 & 1U));
+        }
+        const Mesh m = analyze_cell(values, 0.0, Method::cmc33).mesh;
+        std::vector<std::uint32_t> id(m.vertex_count(), kNone);
+        const auto vertex = [&](std::uint32_t n) {
+            if (id[n] != kNone) return id[n];
+            const float* p = &m.positions[3 * static_cast<std::size_t>(n)];
+            Doubled d{};
+            int on_edge = 0;
+            for (std::size_t a = 0; a < 3; ++a) {
+                const bool end = p[a] == 0.0F || p[a] == 1.0F;
+                on_edge += end ? 1 : 0;
+                d[a] = end ? 2 * static_cast<int>(p[a]) : 1;
+            }
+            // a crossing has its two other coordinates on the cell's faces; cmc33's fan centres
+            // and tubes lie inside the open cell
+            id[n] = on_edge >= 2 ? grid_vertex(2 * i + d[0], 2 * j + d[1], 2 * k + d[2], static_cast<std::size_t>(d[2]))
+                                 : new_vertex(static_cast<double>(i) + static_cast<double>(p[0]),
+                                              static_cast<double>(j) + static_cast<double>(p[1]),
+                                              static_cast<double>(k) + static_cast<double>(p[2]));
+            return id[n];
+        };
+        for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+            add({vertex(m.triangles[3 * t]), vertex(m.triangles[3 * t + 1]), vertex(m.triangles[3 * t + 2])}, high,
+                low);
+        }
     }
 
     std::uint32_t new_vertex(double x, double y, double z)
@@ -279,6 +368,7 @@ private:
     const GridView<T>& g_;
     const Placer& place_;
     const Chooser& chosen_;
+    const label_smooth::Smoothed<T>* smooth_;
     bool flip_;
     Part& out_;
     std::size_t span0_;
@@ -476,9 +566,12 @@ void index_by_label(LabelSurfaces& s)
     }
 }
 
-template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& options)
+template <class T> LabelSurfaces run(const GridView<T>& input, const LabelOptions& options)
 {
     LabelSurfaces out;
+    std::optional<label_smooth::Smoothed<T>> smooth;
+    if (options.smooth != 0) smooth.emplace(input, options.smooth, options.threads);
+    const GridView<T>& g = smooth ? smooth->view() : input;
     const Chooser chosen{options};
     const Placer place(g.spacing, g.origin, g.direction);
     if (g.nx() < 2 || g.ny() < 2 || g.nz() < 2) {
@@ -489,7 +582,7 @@ template <class T> LabelSurfaces run(const GridView<T>& g, const LabelOptions& o
         const int threads = detail::threads_for(options.threads, layers);
         std::vector<Part> parts(static_cast<std::size_t>(threads));
         detail::parallel_chunks(layers, threads, [&](int t, std::int64_t k0, std::int64_t k1) {
-            Worker<T> worker(g, place, chosen, parts[static_cast<std::size_t>(t)]);
+            Worker<T> worker(g, place, chosen, parts[static_cast<std::size_t>(t)], smooth ? &*smooth : nullptr);
             worker.layers(k0, k1);
         });
         std::unordered_set<std::int64_t> present;

@@ -9,6 +9,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <vector>
 
 #include "cmc33/extract.hpp"
 #include "cmc33/topology.hpp"
@@ -49,6 +50,52 @@ std::multiset<Tri> triangle_set(const Mesh& m, bool reverse)
         out.insert(tri);
     }
     return out;
+}
+
+// Whether a float field has a sample within 1e-5 of 0.5, or a face whose diagonals are on opposite
+// sides of 0.5 with its bilinear saddle's numerator (f00 f11 - f10 f01, of f - 0.5) within 1e-6 of 0.
+bool near_tie(const Volume& field)
+{
+    const float* v = field.samples<float>();
+    const Index3 n = field.dims();
+    for (std::int64_t i = 0; i < field.sample_count(); ++i)
+        if (std::fabs(v[i] - 0.5F) < 1e-5F) return true;
+    const std::array<std::int64_t, 3> stride{1, n[0], n[0] * n[1]};
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+        const std::size_t u = (axis + 1) % 3, w = (axis + 2) % 3;
+        for (std::int64_t s = 0; s < field.sample_count(); ++s) {
+            const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+            if (p[u] + 1 >= n[u] || p[w] + 1 >= n[w]) continue;
+            const auto at = [&](std::int64_t du, std::int64_t dw) {
+                return static_cast<double>(v[s + du * stride[u] + dw * stride[w]]) - 0.5;
+            };
+            const double f00 = at(0, 0), f10 = at(1, 0), f11 = at(1, 1), f01 = at(0, 1);
+            const bool ambiguous = (f00 >= 0) == (f11 >= 0) && (f10 >= 0) == (f01 >= 0) && (f00 >= 0) != (f10 >= 0);
+            if (ambiguous && std::fabs(f00 * f11 - f10 * f01) < 1e-6) return true;
+        }
+    }
+    return false;
+}
+
+// Whether every vertex of `a` lies within `tolerance` (in each coordinate) of a vertex of `b`.
+bool near_vertices(const Mesh& a, const Mesh& b, float tolerance)
+{
+    std::vector<std::uint32_t> by_x(b.vertex_count());
+    for (std::uint32_t v = 0; v < by_x.size(); ++v) by_x[v] = v;
+    std::sort(by_x.begin(), by_x.end(),
+              [&](std::uint32_t u, std::uint32_t w) { return b.positions[3 * u] < b.positions[3 * w]; });
+    for (std::uint32_t v = 0; v < a.vertex_count(); ++v) {
+        const Point p = point(a, v);
+        auto it = std::lower_bound(by_x.begin(), by_x.end(), p[0] - tolerance,
+                                   [&](std::uint32_t w, float x) { return b.positions[3 * w] < x; });
+        bool found = false;
+        for (; !found && it != by_x.end() && b.positions[3 * *it] <= p[0] + tolerance; ++it) {
+            const Point q = point(b, *it);
+            found = std::max({std::fabs(p[0] - q[0]), std::fabs(p[1] - q[1]), std::fabs(p[2] - q[2])}) <= tolerance;
+        }
+        if (!found) return false;
+    }
+    return true;
 }
 
 // A segment lies in the box's boundary when both ends share a coordinate at its lowest or highest
@@ -106,10 +153,40 @@ Volume random_labels(std::int64_t n, int labels, std::uint64_t seed, bool smooth
     return v;
 }
 
-void check_field(const Volume& volume, Counts& counts, const std::string& name)
+Volume filtered_indicator(const Volume& labels, std::int64_t label, double sigma)
+{
+    const Index3 n = labels.dims();
+    Volume out(ScalarType::f32, n, labels.spacing(), labels.origin());
+    const std::int32_t* in = labels.samples<std::int32_t>();
+    const std::int64_t count = labels.sample_count();
+    std::vector<double> f(static_cast<std::size_t>(count)), g(f.size());
+    for (std::int64_t i = 0; i < count; ++i) f[static_cast<std::size_t>(i)] = in[i] == label ? 1.0 : 0.0;
+    const auto r = static_cast<std::int64_t>(std::ceil(3 * sigma));
+    const std::array<std::int64_t, 3> stride{1, n[0], n[0] * n[1]};
+    for (std::size_t a = 0; a < 3; ++a) {
+        for (std::int64_t s = 0; s < count; ++s) {
+            const std::int64_t x = s / stride[a] % n[a];
+            double sum = 0, weights = 0;
+            for (std::int64_t d = -r; d <= r; ++d) {
+                if (x + d < 0 || x + d >= n[a]) continue;
+                const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
+                sum += w * f[static_cast<std::size_t>(s + d * stride[a])];
+                weights += w;
+            }
+            g[static_cast<std::size_t>(s)] = sum / weights;
+        }
+        std::swap(f, g);
+    }
+    float* o = out.samples<float>();
+    for (std::int64_t i = 0; i < count; ++i) o[i] = static_cast<float>(f[static_cast<std::size_t>(i)]);
+    return out;
+}
+
+void check_field(const Volume& volume, Counts& counts, const std::string& name, double sigma)
 {
     ++counts.fields;
     LabelOptions options;
+    options.smooth = sigma;
     options.labels = {{std::numeric_limits<std::int64_t>::min(), std::numeric_limits<std::int64_t>::max()}};
     const LabelSurfaces s = label_surfaces(volume, options);
     const Mesh& all = s.interfaces;
@@ -187,7 +264,42 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name)
     }
     // two labels: each surface is the extraction of the lower label's indicator at 0.5 (the
     // higher's reversed), and has the field's topology
-    if (s.present.size() == 2) {
+    // (a label the filter removed still has its share of the filtered indicators: compared only
+    // where the input itself has two labels)
+    bool two_in_input = s.present.size() == 2;
+    if (two_in_input && sigma > 0) {
+        const std::int32_t* samples = volume.samples<std::int32_t>();
+        two_in_input = std::all_of(samples, samples + volume.sample_count(),
+                                   [&](std::int32_t v) { return v == s.present[0] || v == s.present[1]; });
+    }
+    if (sigma > 0 && two_in_input) {
+        // the filtered indicators of two labels sum to 1: the interface is the level set 0.5 of
+        // the lower one's, up to rounding (the library places crossings of f_low - f_high, extract()
+        // of f_low - 0.5); a field with a sample or a face's saddle within rounding of 0.5 can be
+        // decided either way there and is not compared
+        const std::int64_t low = s.present[0];
+        const Volume f = filtered_indicator(volume, low, sigma);
+        if (!near_tie(f)) {
+            ++counts.two_label_compared;
+            const Mesh expected = extract(f, 0.5);
+            const Mesh m_low = label_surface(s, low);
+            // the same triangle count and vertices, each within 0.01 of the other's: rounding moves
+            // a crossing more than 1e-4 where both ends of its edge are within 1e-5 of the tie, and
+            // decides a face or interior saddle within rounding of it either way (the topology,
+            // below, is compared exactly)
+            if (m_low.triangle_count() != expected.triangle_count() || !near_vertices(m_low, expected, 0.01F) ||
+                !near_vertices(expected, m_low, 0.01F)) {
+                fail(counts, counts.two_label_mismatch, name + ": not the extraction of the filtered indicator");
+            }
+            const FieldTopology ft = field_topology(f, 0.5);
+            const MeshTopology t = mesh_topology(m_low);
+            if (!ft.determined || ft.euler != t.euler || ft.b0 != t.components || ft.b1 != t.b1 ||
+                ft.b2 != t.closed_components || ft.boundary_loops != t.boundary_loops) {
+                fail(counts, counts.topology_mismatch, name + ": not the filtered field's topology");
+            }
+        }
+    } else if (sigma == 0 && s.present.size() == 2) {
+        ++counts.two_label_compared;
         const std::int64_t low = s.present[0];
         Volume indicator(ScalarType::f32, volume.dims());
         const std::int32_t* in = volume.samples<std::int32_t>();

@@ -24,6 +24,7 @@ struct Counts {
     std::int64_t duplicate_triangles = 0;
     std::int64_t two_label_mismatch = 0; ///< two-label field: not the extraction of the indicator
     std::int64_t topology_mismatch = 0;  ///< two-label field: not field_topology's numbers
+    std::int64_t two_label_compared = 0; ///< two-label fields compared with the extraction
     std::string first_failure;
 };
 
@@ -31,7 +32,14 @@ struct Counts {
 /// `smooth` is false, else by thresholds of a smooth random function), from `seed`.
 Volume random_labels(std::int64_t n, int labels, std::uint64_t seed, bool smooth);
 
-/// Every check on `volume` (all its labels selected), added to `counts`.
-void check_field(const Volume& volume, Counts& counts, const std::string& name);
+/// Every check on `volume` (all its labels selected), added to `counts`; with sigma > 0 on its
+/// smoothed labels (LabelOptions::smooth), where a two-label field's surfaces are compared with the
+/// extraction of the lower label's indicator filtered here (gaussian_filter()).
+void check_field(const Volume& volume, Counts& counts, const std::string& name, double sigma = 0);
+
+/// A label's indicator (1 at its samples, 0 elsewhere) filtered by the Gaussian of docs/labels.md
+/// ("Smooth labels"): taps exp(-d^2 / (2 sigma^2)) for |d| <= ceil(3 sigma), renormalised to the
+/// samples inside the grid, along x, y and z in turn; written here apart from the library's.
+Volume filtered_indicator(const Volume& labels, std::int64_t label, double sigma);
 
 } // namespace cmc33::label_checks

@@ -21,7 +21,7 @@ namespace {
 using namespace cmc33;
 using label_checks::Counts;
 
-Counts sweep(int labels, int fields, bool smooth)
+Counts sweep(int labels, int fields, bool smooth, double sigma = 0)
 {
     Counts c;
     for (int n = 0; n < fields; ++n) {
@@ -29,16 +29,18 @@ Counts sweep(int labels, int fields, bool smooth)
         const Volume v = label_checks::random_labels(size, labels, static_cast<std::uint64_t>(n), smooth);
         label_checks::check_field(v, c,
                                   std::to_string(labels) + " labels, " + (smooth ? "smooth" : "i.i.d.") + " field " +
-                                      std::to_string(n) + " (" + std::to_string(size) + "^3)");
+                                      std::to_string(n) + " (" + std::to_string(size) + "^3)" +
+                                      (sigma > 0 ? ", sigma " + std::to_string(sigma) : ""),
+                                  sigma);
     }
-    std::cout << labels << " labels, " << (smooth ? "smooth" : "i.i.d.") << ": " << c.fields << " fields, "
-              << c.label_surfaces << " label surfaces; not closed " << c.not_closed << ", not manifold "
+    std::cout << labels << " labels, " << (smooth ? "smooth" : "i.i.d.") << ", sigma " << sigma << ": " << c.fields
+              << " fields, " << c.label_surfaces << " label surfaces; not closed " << c.not_closed << ", not manifold "
               << c.not_manifold << " (" << c.nonmanifold_edges << " edges, " << c.nonmanifold_vertices
               << " vertices), not oriented " << c.not_oriented << ", not embedded " << c.not_embedded
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
-              << ", topology mismatches " << c.topology_mismatch << (c.first_failure.empty() ? "" : "; first: ")
-              << c.first_failure << "\n";
+              << ", topology mismatches " << c.topology_mismatch << " of " << c.two_label_compared
+              << (c.first_failure.empty() ? "" : "; first: ") << c.first_failure << "\n";
     return c;
 }
 
@@ -69,6 +71,73 @@ TEST(Labels, ThreeAndFourLabelFields)
 {
     for (const int labels : {3, 4})
         for (const bool smooth : {false, true}) expect_guarantees(sweep(labels, 75, smooth));
+}
+
+// Smooth labels, two of them: the filtered indicators sum to 1, so each label's surface is the
+// extraction of the lower label's filtered indicator at 0.5 and has that field's topology.
+TEST(Labels, SmoothTwoLabelFieldsAreTheFilteredIndicatorsLevelSet)
+{
+    for (const double sigma : {0.6, 1.2})
+        for (const bool smooth : {false, true}) {
+            const Counts c = sweep(2, 60, smooth, sigma);
+            expect_guarantees(c);
+            EXPECT_EQ(c.two_label_mismatch, 0) << c.first_failure;
+            EXPECT_EQ(c.topology_mismatch, 0) << c.first_failure;
+            EXPECT_GT(c.two_label_compared, 40); // the rest have a sample within rounding of a tie
+        }
+}
+
+// Smooth labels, three and four: the same guarantees as without smoothing.
+TEST(Labels, SmoothThreeAndFourLabelFields)
+{
+    for (const int labels : {3, 4})
+        for (const bool smooth : {false, true})
+            for (const double sigma : {0.6, 1.5}) expect_guarantees(sweep(labels, 30, smooth, sigma));
+}
+
+// A label thinner than the filter vanishes: a voxel of 2 inside 1 leaves only 1, and no surface.
+TEST(Labels, SmoothRemovesALabelThinnerThanTheFilter)
+{
+    Volume v(ScalarType::i32, {7, 7, 7});
+    std::int32_t* s = v.samples<std::int32_t>();
+    std::fill(s, s + v.sample_count(), 1);
+    s[3 + 7 * (3 + 7 * 3)] = 2;
+    LabelOptions o;
+    EXPECT_EQ(label_surfaces(v, o).present, (std::vector<std::int64_t>{1, 2}));
+    o.smooth = 1.5;
+    const LabelSurfaces smoothed = label_surfaces(v, o);
+    EXPECT_EQ(smoothed.present, (std::vector<std::int64_t>{1}));
+    EXPECT_EQ(smoothed.interfaces.triangle_count(), 0U);
+    // a block of 3^3 stays, rounded: its crossings move off the edges' midpoints
+    for (std::int64_t k = 2; k <= 4; ++k)
+        for (std::int64_t j = 2; j <= 4; ++j)
+            for (std::int64_t i = 2; i <= 4; ++i) s[i + 7 * (j + 7 * k)] = 2;
+    o.smooth = 0.8;
+    const LabelSurfaces block = label_surfaces(v, o);
+    EXPECT_EQ(block.present, (std::vector<std::int64_t>{1, 2}));
+    const MeshTopology t = mesh_topology(label_surface(block, 2));
+    EXPECT_EQ(t.components, 1);
+    EXPECT_EQ(t.euler, 2);
+    bool off_midpoint = false;
+    for (const float x : block.interfaces.positions)
+        off_midpoint = off_midpoint || std::fabs(x * 2 - std::round(x * 2)) > 1e-3F;
+    EXPECT_TRUE(off_midpoint);
+}
+
+TEST(Labels, SmoothSigmaMustBeFiniteAndPositive)
+{
+    const Volume v = label_checks::random_labels(5, 3, 1, false);
+    for (const double sigma : {-1.0, std::nan(""), HUGE_VAL}) {
+        LabelOptions o;
+        o.smooth = sigma;
+        try {
+            label_surfaces(v, o);
+            FAIL() << sigma;
+        } catch (const Error& e) {
+            EXPECT_EQ(e.status(), Status::invalid_argument);
+            EXPECT_NE(std::string(e.what()).find("smooth"), std::string::npos) << e.what();
+        }
+    }
 }
 
 // The label surfaces of one cell (corners x fastest, then y, then z), the guarantees checked.
@@ -150,6 +219,7 @@ TEST(Labels, SameOutputForEveryThreadCount)
                 Volume v = label_checks::random_labels(9, labels, seed, smooth);
                 if (seed == 2) v.set_direction({{{0.6, 0.8, 0}, {-0.8, 0.6, 0}, {0, 0, 1}}});
                 LabelOptions o;
+                o.smooth = smooth ? 1.0 : 0.0; // and filtered labels
                 o.threads = 1;
                 o.normals = true;
                 const LabelSurfaces one = label_surfaces(v, o);

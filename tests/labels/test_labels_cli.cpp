@@ -138,6 +138,42 @@ TEST(LabelsCli, InterfaceLabelsPastInt32AreUint)
     }
 }
 
+// --smooth SIGMA: the library's smoothed surfaces, the JSON says so, and a bad SIGMA is refused as
+// a usage error (exit 2) before any work, nothing written.
+TEST(LabelsCli, Smooth)
+{
+    const fs::path dir = test::temp_dir();
+    const Volume seg = label_checks::random_labels(9, 3, 8, true);
+    io::write_volume(seg, dir / "seg.nrrd");
+    LabelOptions o;
+    o.smooth = 1.25;
+    const LabelSurfaces s = label_surfaces(seg, o);
+    ASSERT_EQ(std::system((std::string(CMC33_EXE) + " labels " + (dir / "seg.nrrd").string() + " -o " +
+                           (dir / "out").string() + " --smooth 1.25 --json >" + (dir / "j").string())
+                              .c_str()),
+              0);
+    const nlohmann::json j = nlohmann::json::parse(test::read_file(dir / "j"));
+    EXPECT_EQ(j["smooth"], 1.25);
+    EXPECT_EQ(j["interface_triangles"], static_cast<std::int64_t>(s.interfaces.triangle_count()));
+    ASSERT_FALSE(s.selected.empty());
+    for (const std::int64_t l : s.selected) {
+        const Mesh m = io::read_mesh(dir / "out" / ("label_" + std::to_string(l) + ".ply"));
+        const Mesh want = label_surface(s, l);
+        EXPECT_TRUE(m.positions == want.positions) << l;
+        EXPECT_TRUE(m.triangles == want.triangles) << l;
+    }
+    EXPECT_NE(label_surfaces(seg).interfaces.positions, s.interfaces.positions);
+    for (const char* bad : {"-1", "abc", "nan", "inf", "2000"}) {
+        EXPECT_EQ(run("labels " + (dir / "seg.nrrd").string() + " -o " + (dir / "bad").string() + " --smooth " + bad,
+                      dir / "err"),
+                  2)
+            << bad;
+        const std::string err = test::read_file(dir / "err");
+        EXPECT_EQ(err.rfind("cmc33: --smooth: ", 0), 0U) << err;
+        EXPECT_FALSE(fs::exists(dir / "bad")) << bad;
+    }
+}
+
 TEST(LabelsCli, BadInput)
 {
     const fs::path dir = test::temp_dir();

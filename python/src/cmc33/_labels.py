@@ -97,7 +97,7 @@ def _label_samples(labels: Any) -> np.ndarray:
 def label_surfaces(labels: Union[Volume, Any], *, select: LabelSelection = "all", background: int = 0,
                    spacing: Optional[Sequence[float]] = None, origin: Optional[Sequence[float]] = None,
                    direction: Any = None, normals: bool = False, surfaces: bool = True,
-                   threads: int = 0) -> LabelSurfaces:
+                   smooth: float = 0.0, threads: int = 0) -> LabelSurfaces:
     """The surfaces of every label of a segmentation, from one pass (cmc33::label_surfaces).
 
     The labels partition space (each point belongs to the label whose trilinearly interpolated
@@ -126,6 +126,11 @@ def label_surfaces(labels: Union[Volume, Any], *, select: LabelSelection = "all"
     surfaces : bool
         Also make each selected label's closed surface (default True); False gives only the
         interfaces and their labels.
+    smooth : float
+        Sigma in voxels of a Gaussian each label's indicator is filtered by first (0, the default:
+        none): each sample then takes the label whose filtered indicator is largest, and the
+        interfaces pass where two labels' filtered indicators are equal, with the same partition
+        guarantees (docs/labels.md, "Smooth labels").
     threads : int
         Worker threads, 0 (default) for every core.
 
@@ -145,9 +150,11 @@ def label_surfaces(labels: Union[Volume, Any], *, select: LabelSelection = "all"
     if isinstance(background, bool) or not isinstance(background, (int, np.integer)):
         raise ValueError(f"background {background!r}; expected an integer label")
     ranges = [] if isinstance(select, str) and select == "all" else _ranges(select)
+    if isinstance(smooth, bool) or not isinstance(smooth, (int, float, np.integer, np.floating)):
+        raise ValueError(f"smooth {smooth!r}; expected a number of voxels >= 0")
     result = _cmc33.label_surfaces(samples, vec3((1, 1, 1) if spacing is None else spacing, "spacing"),
                                    vec3((0, 0, 0) if origin is None else origin, "origin"),
                                    IDENTITY if direction is None else mat3(direction), int(background), ranges,
-                                   bool(normals), thread_count(threads), bool(surfaces))
+                                   bool(normals), thread_count(threads), bool(surfaces), float(smooth))
     interfaces, front, behind, per_label, present, selected, two, many, core = result
     return LabelSurfaces(interfaces, front, behind, per_label, tuple(present), tuple(selected), two, many, core)

@@ -40,6 +40,13 @@ struct LabelOptions {
     /// Per-vertex unit normals on `interfaces` (and so on every label_surface()): at each vertex the
     /// area-weighted mean of its triangles' normals, as each mesh is wound (docs/labels.md).
     bool normals = false;
+    /// Smooth labels: 0, or sigma in voxels of the Gaussian each label's indicator is filtered
+    /// by first (truncated at 3 sigma). Each sample then takes the label whose filtered indicator
+    /// is largest (ties to the lower), and the interfaces pass where the two labels' filtered
+    /// indicators are equal on the edges, with cmc33's decisions on their difference in cells
+    /// of two labels (docs/labels.md, "Smooth labels"). @throws Error{invalid_argument} unless
+    /// finite and >= 0.
+    double smooth = 0;
 };
 
 /// The interfaces of a label map, in world coordinates as extract() places vertices (the volume's
