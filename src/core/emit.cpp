@@ -190,6 +190,8 @@ void RangeExtractor<T>::build_short_tilings()
     // (std::max_element: the WebAssembly build's libc++ 13 has no std::ranges::max_element)
     const std::int64_t largest = 3 * length + *std::max_element(kEdgeSlot.begin(), kEdgeSlot.end());
     if (largest > std::numeric_limits<std::uint16_t>::max()) return;
+    // a grid of a few cells (analyze_cell's one) would spend more on the table than it saves
+    if ((nx_ - 1) * (ny_ - 1) * (nz_ - 1) < 64) return;
     short_offsets_.assign(4 * 256 * 3 * kShortTiling, 0);
     for (unsigned code = 0; code < 256; ++code) {
         const detail::Tiling* tl = fixed_tiling_[code];

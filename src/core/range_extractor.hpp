@@ -193,8 +193,8 @@ private:
     /// vertex and at most kShortTiling triangles, where each id of their triangles sits in the
     /// four id rows of IdRows, so that emit_row_cells goes from a cell's code to its ids in two
     /// loads. The offsets are 16 bits, a table of 24 KiB that stays in the L1 cache better than
-    /// 32-bit ones; grids wider than 7281 samples, where they would not fit, have none (every
-    /// cell takes emit_cell()).
+    /// 32-bit ones; grids wider than 7281 samples, where they would not fit, and grids of fewer
+    /// than 64 cells have none (every cell takes emit_cell()).
     void build_short_tilings();
 
     /// kTriangleCodes followed by 3 * kShortTiling zeros, so that a short tiling's fixed-size copy
