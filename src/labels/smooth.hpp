@@ -83,9 +83,10 @@ public:
     /// f_low - f_high at a sample, rounded to a float: >= 0 exactly where the sample is nearer low
     /// than high (ties to the lower label), and a float, so that the products of two such values
     /// are exact in double and a face's saddle sign is decided exactly.
-    float difference(std::int64_t low, std::int64_t high, std::int64_t i, std::int64_t j, std::int64_t k) const
+    double difference(std::int64_t low, std::int64_t high, std::int64_t i, std::int64_t j, std::int64_t k) const
     {
-        return static_cast<float>(static_cast<double>(value(low, i, j, k)) - static_cast<double>(value(high, i, j, k)));
+        const double d = static_cast<double>(value(low, i, j, k)) - static_cast<double>(value(high, i, j, k));
+        return static_cast<double>(static_cast<float>(d));
     }
 
 private:
@@ -162,7 +163,8 @@ private:
                     for (std::int64_t l = l0; l < l1; ++l) {
                         const std::int64_t base = (l % size[u]) * stride[u] + (l / size[u]) * stride[v];
                         for (std::int64_t x = 0; x < size[a]; ++x)
-                            in[static_cast<std::size_t>(x)] = b.f[static_cast<std::size_t>(base + x * stride[a])];
+                            in[static_cast<std::size_t>(x)] =
+                                static_cast<double>(b.f[static_cast<std::size_t>(base + x * stride[a])]);
                         for (std::int64_t x = 0; x < size[a]; ++x) {
                             double s = 0;
                             const std::int64_t from = std::max<std::int64_t>(0, x - r),
