@@ -77,6 +77,14 @@ bool near_tie(const Volume& field)
     return false;
 }
 
+// Whether a surface has the Euler characteristic, Betti numbers and boundary loops of the level set
+// field_topology() found.
+bool same_topology(const FieldTopology& f, const MeshTopology& t)
+{
+    return f.determined && f.euler == t.euler && f.b0 == t.components && f.b1 == t.b1 && f.b2 == t.closed_components &&
+           f.boundary_loops == t.boundary_loops;
+}
+
 // Whether every vertex of `a` lies within `tolerance` (in each coordinate) of a vertex of `b`.
 bool near_vertices(const Mesh& a, const Mesh& b, float tolerance)
 {
@@ -291,10 +299,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
                 !near_vertices(expected, m_low, 0.01F)) {
                 fail(counts, counts.two_label_mismatch, name + ": not the extraction of the filtered indicator");
             }
-            const FieldTopology ft = field_topology(f, 0.5);
-            const MeshTopology t = mesh_topology(m_low);
-            if (!ft.determined || ft.euler != t.euler || ft.b0 != t.components || ft.b1 != t.b1 ||
-                ft.b2 != t.closed_components || ft.boundary_loops != t.boundary_loops) {
+            if (!same_topology(field_topology(f, 0.5), mesh_topology(m_low))) {
                 fail(counts, counts.topology_mismatch, name + ": not the filtered field's topology");
             }
         }
@@ -312,10 +317,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
 
             fail(counts, counts.two_label_mismatch, name + ": not the extraction of the lower label's indicator");
         }
-        const FieldTopology f = field_topology(indicator, 0.5);
-        const MeshTopology t = mesh_topology(m_low);
-        if (!f.determined || f.euler != t.euler || f.b0 != t.components || f.b1 != t.b1 ||
-            f.b2 != t.closed_components || f.boundary_loops != t.boundary_loops) {
+        if (!same_topology(field_topology(indicator, 0.5), mesh_topology(m_low))) {
             fail(counts, counts.topology_mismatch, name + ": not the field's topology");
         }
     }
