@@ -77,6 +77,142 @@ bool near_tie(const Volume& field)
     return false;
 }
 
+// Each label's surface's Euler characteristic computed from the labels alone, by the rules of
+// docs/labels.md ("The partition") and not through the extractor: chi is additive over the open
+// vertices, edges, faces and cells of the grid, so chi(R) of a label's region R is the sum of
+// chi_c(R within each), and its surface S (R's boundary less the box) has chi(S) = 2 chi(R) - chi(B)
+// with B = R on the box's faces. Per open piece:
+//   - a sample of the label: 1; an edge with the label at both ends: -1 (an edge of two labels
+//     holds a half-open part of each: 0);
+//   - a face: 1 where all four corners hold the label; -1 where the label is joined across a
+//     diagonal that holds its only two corners (the rest of the face cut off in two pieces); else 0
+//     (each piece meets the face's boundary in one arc);
+//   - a cell: all one label, -1 (a cube less its boundary sphere); two labels, (chi(S_c) - chi(R on
+//     the cell's surface)) / 2 for each, with chi(S_c) from field_topology() of the cell's indicator
+//     at 0.5; three or more, 0 for every label but the core's, which takes 1 - chi(its part of the
+//     cell's surface) (cones and frustums have the chi of their base; the core with its frustums
+//     is a ball).
+std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
+{
+    const std::int32_t* v = volume.samples<std::int32_t>();
+    const Index3 n = volume.dims();
+    const auto at = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return v[i + n[0] * (j + n[1] * k)]; };
+    std::map<std::int64_t, std::int64_t> region, box;
+    // a face's contribution to label x, its corners in cyclic order
+    const auto face = [](const std::array<std::int64_t, 4>& l, std::int64_t x) -> std::int64_t {
+        const int mine = static_cast<int>(std::count(l.begin(), l.end(), x));
+        if (mine == 4) return 1;
+        if (mine != 2) return 0;
+        const bool d0 = l[0] == l[2], d1 = l[1] == l[3];
+        if (!d0 && !d1) return 0;
+        // the label on a diagonal, the lower one where both diagonals hold one
+        const std::int64_t joined = d0 && d1 ? std::min(l[0], l[1]) : (d0 ? l[0] : l[1]);
+        return joined == x ? -1 : 0;
+    };
+    const std::array<std::int64_t, 3> dims{n[0], n[1], n[2]};
+    const auto on_box = [&](const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) {
+        for (std::size_t a = 0; a < 3; ++a)
+            if (lo[a] == hi[a] && (lo[a] == 0 || lo[a] == dims[a] - 1)) return true;
+        return false;
+    };
+    const auto add = [&](std::int64_t label, std::int64_t c, bool boxed) {
+        region[label] += c;
+        if (boxed) box[label] += c;
+    };
+    std::map<unsigned, std::int64_t> cell_surface; // chi(S_c) by corner pattern
+    for (std::int64_t k = 0; k < n[2]; ++k)
+        for (std::int64_t j = 0; j < n[1]; ++j)
+            for (std::int64_t i = 0; i < n[0]; ++i) {
+                const std::array<std::int64_t, 3> p{i, j, k};
+                add(at(i, j, k), 1, on_box(p, p));
+                for (std::size_t a = 0; a < 3; ++a) {
+                    std::array<std::int64_t, 3> q = p;
+                    if (++q[a] >= dims[a]) continue;
+                    if (at(i, j, k) == at(q[0], q[1], q[2])) add(at(i, j, k), -1, on_box(p, q));
+                    // the face spanned by axes a and b = a + 1 at p
+                    const std::size_t b = (a + 1) % 3;
+                    std::array<std::int64_t, 3> r = p, t = q;
+                    if (++r[b] >= dims[b]) continue;
+                    ++t[b];
+                    const std::array<std::int64_t, 4> l{at(p[0], p[1], p[2]), at(q[0], q[1], q[2]),
+                                                        at(t[0], t[1], t[2]), at(r[0], r[1], r[2])};
+                    std::array<std::int64_t, 4> seen = l;
+                    std::sort(seen.begin(), seen.end());
+                    for (auto x = seen.begin(); x != std::unique(seen.begin(), seen.end()); ++x) {
+                        if (const std::int64_t c = face(l, *x); c != 0) add(*x, c, on_box(p, t));
+                    }
+                }
+                if (i + 1 >= n[0] || j + 1 >= n[1] || k + 1 >= n[2]) continue;
+                std::array<std::int64_t, 8> c{};
+                for (unsigned m = 0; m < 8; ++m) c[m] = at(i + (m & 1U), j + (m >> 1 & 1U), k + (m >> 2 & 1U));
+                std::array<std::int64_t, 8> labels = c;
+                std::sort(labels.begin(), labels.end());
+                const auto end = std::unique(labels.begin(), labels.end());
+                const auto count = end - labels.begin();
+                if (count == 1) {
+                    add(c[0], -1, false);
+                    continue;
+                }
+                // chi of label x on the cell's surface, and its pieces there (corners joined by
+                // edges and joined diagonals)
+                const auto on_surface = [&](std::int64_t x, int& pieces) {
+                    std::array<unsigned, 8> root{0, 1, 2, 3, 4, 5, 6, 7};
+                    const auto find = [&](unsigned u) {
+                        while (root[u] != u) u = root[u];
+                        return u;
+                    };
+                    std::int64_t chi = 0;
+                    for (unsigned m = 0; m < 8; ++m) chi += c[m] == x ? 1 : 0;
+                    for (unsigned m = 0; m < 8; ++m)
+                        for (unsigned a = 0; a < 3; ++a)
+                            if ((m >> a & 1U) == 0 && c[m] == x && c[m | 1U << a] == x) {
+                                --chi;
+                                root[find(m)] = find(m | 1U << a);
+                            }
+                    for (unsigned a = 0; a < 3; ++a)
+                        for (unsigned side = 0; side < 2; ++side) {
+                            const unsigned b = (a + 1) % 3, d = (a + 2) % 3, o = side << a;
+                            const std::array<unsigned, 4> q{o, o | 1U << b, o | 1U << b | 1U << d, o | 1U << d};
+                            const std::array<std::int64_t, 4> l{c[q[0]], c[q[1]], c[q[2]], c[q[3]]};
+                            const std::int64_t f = face(l, x);
+                            chi += f;
+                            if (f == -1) root[find(l[0] == x ? q[0] : q[1])] = find(l[0] == x ? q[2] : q[3]);
+                        }
+                    pieces = 0;
+                    for (unsigned m = 0; m < 8; ++m) pieces += c[m] == x && find(m) == m ? 1 : 0;
+                    return chi;
+                };
+                if (count == 2) {
+                    unsigned pattern = 0;
+                    for (unsigned m = 0; m < 8; ++m) pattern |= (c[m] == labels[0] ? 1U : 0U) << m;
+                    auto it = cell_surface.find(pattern);
+                    if (it == cell_surface.end()) {
+                        Volume one(ScalarType::f32, {2, 2, 2});
+                        for (unsigned m = 0; m < 8; ++m)
+                            one.samples<float>()[m] = (pattern >> m & 1U) != 0 ? 1.0F : 0.0F;
+                        it = cell_surface.emplace(pattern, field_topology(one, 0.5).euler).first;
+                    }
+                    for (auto x = labels.begin(); x != end; ++x) {
+                        int pieces = 0;
+                        const std::int64_t chi = on_surface(*x, pieces);
+                        add(*x, (it->second - chi) / 2, false);
+                    }
+                    continue;
+                }
+                for (auto x = labels.begin(); x != end; ++x) {
+                    int pieces = 0;
+                    const std::int64_t chi = on_surface(*x, pieces);
+                    if (pieces != 1 || chi != 1) { // the core's label: the lowest not one disk
+                        add(*x, 1 - chi, false);
+                        break;
+                    }
+                }
+            }
+    std::map<std::int64_t, std::int64_t> out;
+    for (const auto& [label, chi] : region) out[label] = 2 * chi - box[label];
+    return out;
+}
+
 // Whether a surface has the Euler characteristic, Betti numbers and boundary loops of the level set
 // field_topology() found.
 bool same_topology(const FieldTopology& f, const MeshTopology& t)
@@ -272,6 +408,20 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
     }
     // two labels: each surface is the extraction of the lower label's indicator at 0.5 (the
     // higher's reversed), and has the field's topology
+    // each label's Euler characteristic from the labels alone (not with smoothing, whose faces and
+    // cells follow the filtered values)
+    if (sigma == 0 && volume.type() == ScalarType::i32) {
+        const std::map<std::int64_t, std::int64_t> euler = euler_from_labels(volume);
+        for (const std::int64_t label : s.selected) {
+            const auto it = euler.find(label);
+            const std::int64_t got = mesh_topology(label_surface(s, label)).euler;
+            if (it == euler.end() || it->second != got) {
+                fail(counts, counts.euler_mismatch,
+                     name + ", label " + std::to_string(label) + ": Euler characteristic " + std::to_string(got) +
+                         ", the labels give " + (it == euler.end() ? std::string("none") : std::to_string(it->second)));
+            }
+        }
+    }
     // (a label the filter removed still has its share of the filtered indicators: compared only
     // where the input itself has two labels)
     bool two_in_input = s.present.size() == 2;

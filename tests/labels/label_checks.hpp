@@ -25,6 +25,7 @@ struct Counts {
     std::int64_t two_label_mismatch = 0; ///< two-label field: not the extraction of the indicator
     std::int64_t topology_mismatch = 0;  ///< two-label field: not field_topology's numbers
     std::int64_t two_label_compared = 0; ///< two-label fields compared with the extraction
+    std::int64_t euler_mismatch = 0;     ///< a label's Euler characteristic not the one its labels give
     std::string first_failure;
 };
 

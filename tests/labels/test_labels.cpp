@@ -40,6 +40,7 @@ Counts sweep(int labels, int fields, bool smooth, double sigma = 0)
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
               << ", topology mismatches " << c.topology_mismatch << " of " << c.two_label_compared
+              << ", Euler characteristics not the labels' " << c.euler_mismatch
               << (c.first_failure.empty() ? "" : "; first: ") << c.first_failure << "\n";
     return c;
 }
@@ -53,6 +54,7 @@ void expect_guarantees(const Counts& c)
     EXPECT_EQ(c.union_not_embedded, 0) << c.first_failure;
     EXPECT_EQ(c.not_embedded, 0) << c.first_failure;
     EXPECT_EQ(c.duplicate_triangles, 0) << c.first_failure;
+    EXPECT_EQ(c.euler_mismatch, 0) << c.first_failure;
 }
 
 TEST(Labels, TwoLabelFieldsAreTheIndicatorsLevelSet)

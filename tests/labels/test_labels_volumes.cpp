@@ -77,9 +77,11 @@ void check_segmentation(const std::string& file, const Volume& seg, double sigma
               << c.not_embedded << ", union not watertight " << c.union_not_watertight << ", union not embedded "
               << c.union_not_embedded << ", repeated " << c.duplicate_triangles << ", two-label mismatch "
               << c.two_label_mismatch << ", topology mismatch " << c.topology_mismatch << " (of "
-              << c.two_label_compared << " compared)\n";
+              << c.two_label_compared << " compared), Euler characteristic not the labels' " << c.euler_mismatch
+              << "\n";
     EXPECT_EQ(c.not_closed + c.not_oriented + c.not_embedded + c.union_not_watertight + c.union_not_embedded +
-                  c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch + c.not_manifold,
+                  c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch + c.not_manifold +
+                  c.euler_mismatch,
               0)
         << c.first_failure;
 }
