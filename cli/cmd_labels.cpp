@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -296,16 +295,8 @@ void add_labels(CLI::App& app)
                     "Smooth labels: filter each label's indicator by a Gaussian of SIGMA voxels first (0, the "
                     "default: none); the surfaces stay one partition with the same guarantees")
         ->type_name("SIGMA")
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                char* end = nullptr;
-                const double v = std::strtod(text.c_str(), &end);
-                if (text.empty() || *end != '\0' || !(v >= 0 && v <= 1000)) {
-                    return "expected a number of voxels from 0 (none) to 1000, got '" + text + "'";
-                }
-                return {};
-            },
-            "SIGMA", "sigma"));
+        ->check(real_number("a number of voxels from 0 (none) to 1000", [](double v) { return v >= 0 && v <= 1000; },
+                            "SIGMA"));
     cmd->add_option("--label-names", args->label_names,
                     "A colour table naming the labels: lines \"value name R G B [A]\" (3D Slicer .ctbl/.txt, "
                     "FreeSurfer LUT) or ITK-SNAP's label descriptions; a .seg.nrrd's own segment names are read "

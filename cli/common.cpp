@@ -45,16 +45,8 @@ const CLI::Validator kPositiveInteger(
     },
     "N >= 1", "positive integer");
 
-const CLI::Validator kPositiveReal(
-    [](std::string& text) -> std::string {
-        char* end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || *end != '\0' || !std::isfinite(v) || v <= 0) {
-            return "expected a finite number > 0, got '" + text + "'";
-        }
-        return {};
-    },
-    "> 0", "positive number");
+const CLI::Validator kPositiveReal =
+    real_number("a finite number > 0", [](double v) { return std::isfinite(v) && v > 0; }, "> 0");
 
 } // namespace
 
@@ -308,6 +300,18 @@ CLI::Validator whole_number(std::int64_t min, std::int64_t max)
             return {};
         },
         "N " + range, "whole number");
+}
+
+CLI::Validator real_number(const std::string& expected, bool (*accept)(double), const std::string& name)
+{
+    return CLI::Validator(
+        [expected, accept](std::string& text) -> std::string {
+            char* end = nullptr;
+            const double v = std::strtod(text.c_str(), &end);
+            if (text.empty() || *end != '\0' || !accept(v)) return "expected " + expected + ", got '" + text + "'";
+            return {};
+        },
+        name, name);
 }
 
 CLI::Validator unsigned_number()

@@ -75,6 +75,9 @@ CLI::Validator number_check();
 /// The whole text is a whole number in [min, max] (message "expected a whole number from 0 to
 /// 1024, got '100000'"; ">= min" when max is the largest int64).
 CLI::Validator whole_number(std::int64_t min, std::int64_t max);
+/// The whole text is one decimal number that `accept` takes (message "expected <expected>, got
+/// '<text>'"); `name` is what --help shows.
+CLI::Validator real_number(const std::string& expected, bool (*accept)(double), const std::string& name);
 /// A whole number >= 0 that fits 64 bits unsigned (--seed, --header-bytes).
 CLI::Validator unsigned_number();
 /// The value is not empty (an unset shell variable in `-o "$OUT"`).

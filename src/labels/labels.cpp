@@ -211,7 +211,7 @@ private:
                 const Doubled from{q[0] - 1, q[1] - 1, q[2] - 1};
                 std::array<double, 3> p{0.25 * q[0], 0.25 * q[1], 0.25 * q[2]};
                 if (smooth_ != nullptr && odd_count(from) == 1) {
-                    const std::size_t axis = from[0] == 1 ? 0 : (from[1] == 1 ? 1 : 2);
+                    const std::size_t axis = odd_axis(from);
                     p[axis] = 0.25 + 0.5 * edge_t(2 * i + from[0], 2 * j + from[1], 2 * k + from[2], axis);
                 }
                 id = new_vertex(static_cast<double>(i) + p[0], static_cast<double>(j) + p[1],
@@ -266,7 +266,7 @@ private:
                                     0.5 * static_cast<double>(z)};
             const Doubled d{static_cast<int>(x & 1), static_cast<int>(y & 1), static_cast<int>(z & 1)};
             if (smooth_ != nullptr && odd_count(d) == 1) {
-                const std::size_t axis = d[0] == 1 ? 0 : (d[1] == 1 ? 1 : 2);
+                const std::size_t axis = odd_axis(d);
                 p[axis] = std::floor(p[axis]) + edge_t(x, y, z, axis);
             }
             id = new_vertex(p[0], p[1], p[2]);
@@ -276,6 +276,8 @@ private:
     }
 
     static int odd_count(const Doubled& d) { return (d[0] & 1) + (d[1] & 1) + (d[2] & 1); }
+    // The axis of the one odd coordinate of an edge's midpoint.
+    static std::size_t odd_axis(const Doubled& d) { return (d[0] & 1) != 0 ? 0 : ((d[1] & 1) != 0 ? 1 : 2); }
 
     // Where f_low - f_high of the edge's two labels is 0 on the edge at doubled coordinates
     // (x, y, z) along `axis`, from its lower end: linear along the edge as cmc33 places a crossing,

@@ -93,11 +93,12 @@ private:
     // Each label's bounding box grown by r and cut to the grid.
     void find_boxes(const GridView<T>& g, std::int64_t r)
     {
+        std::size_t last = 0; // the box of the sample before, found again only when the label changes
         for (std::int64_t k = 0; k < g.nz(); ++k)
             for (std::int64_t j = 0; j < g.ny(); ++j)
                 for (std::int64_t i = 0; i < g.nx(); ++i) {
                     const auto l = static_cast<std::int64_t>(g(i, j, k));
-                    if (boxes_.empty() || boxes_[last_].label != l) {
+                    if (boxes_.empty() || boxes_[last].label != l) {
                         const auto it = std::lower_bound(boxes_.begin(), boxes_.end(), l,
                                                          [](const Box& b, std::int64_t v) { return b.label < v; });
                         if (it == boxes_.end() || it->label != l) {
@@ -105,13 +106,13 @@ private:
                             b.label = l;
                             b.lo = {i, j, k};
                             b.hi = {i, j, k};
-                            last_ = static_cast<std::size_t>(it - boxes_.begin());
+                            last = static_cast<std::size_t>(it - boxes_.begin());
                             boxes_.insert(it, b);
                         } else {
-                            last_ = static_cast<std::size_t>(it - boxes_.begin());
+                            last = static_cast<std::size_t>(it - boxes_.begin());
                         }
                     }
-                    Box& b = boxes_[last_];
+                    Box& b = boxes_[last];
                     const std::array<std::int64_t, 3> p{i, j, k};
                     for (std::size_t a = 0; a < 3; ++a) {
                         b.lo[a] = std::min(b.lo[a], p[a]);
@@ -203,7 +204,6 @@ private:
     }
 
     std::vector<Box> boxes_; ///< ascending by label
-    std::size_t last_ = 0;
     std::vector<T> labels_;
     GridView<T> view_;
 };
