@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <vector>
@@ -77,6 +78,71 @@ bool near_tie(const Volume& field)
     return false;
 }
 
+// The label a face joins across a diagonal (corners in cyclic order): the label on both ends of a
+// diagonal, the lower one where both diagonals hold one; none without such a diagonal.
+std::optional<std::int64_t> joined_label(const std::array<std::int64_t, 4>& l)
+{
+    const bool d0 = l[0] == l[2], d1 = l[1] == l[3];
+    if (!d0 && !d1) return std::nullopt;
+    return d0 && d1 ? std::min(l[0], l[1]) : (d0 ? l[0] : l[1]);
+}
+
+// An open face's contribution to the Euler characteristic of label x's region (euler_from_labels()).
+std::int64_t face(const std::array<std::int64_t, 4>& l, std::int64_t x)
+{
+    const int mine = static_cast<int>(std::count(l.begin(), l.end(), x));
+    if (mine == 4) return 1;
+    if (mine != 2) return 0;
+    return joined_label(l) == x ? -1 : 0;
+}
+
+using Corners = std::array<std::int64_t, 8>; ///< a cell's labels, corner m at (m & 1, m >> 1 & 1, m >> 2 & 1)
+
+// Chi of label x's part of a cell's surface, and its pieces there (corners joined by edges and by
+// joined diagonals).
+std::int64_t on_cell_surface(const Corners& c, std::int64_t x, int& pieces)
+{
+    std::array<unsigned, 8> root{0, 1, 2, 3, 4, 5, 6, 7};
+    const auto find = [&](unsigned u) {
+        while (root[u] != u) u = root[u];
+        return u;
+    };
+    std::int64_t chi = 0;
+    for (unsigned m = 0; m < 8; ++m) chi += c[m] == x ? 1 : 0;
+    for (unsigned m = 0; m < 8; ++m)
+        for (unsigned a = 0; a < 3; ++a)
+            if ((m >> a & 1U) == 0 && c[m] == x && c[m | 1U << a] == x) {
+                --chi;
+                root[find(m)] = find(m | 1U << a);
+            }
+    for (unsigned a = 0; a < 3; ++a)
+        for (unsigned side = 0; side < 2; ++side) {
+            const unsigned b = (a + 1) % 3, d = (a + 2) % 3, o = side << a;
+            const std::array<unsigned, 4> q{o, o | 1U << b, o | 1U << b | 1U << d, o | 1U << d};
+            const std::array<std::int64_t, 4> l{c[q[0]], c[q[1]], c[q[2]], c[q[3]]};
+            const std::int64_t f = face(l, x);
+            chi += f;
+            if (f == -1) root[find(l[0] == x ? q[0] : q[1])] = find(l[0] == x ? q[2] : q[3]);
+        }
+    pieces = 0;
+    for (unsigned m = 0; m < 8; ++m) pieces += c[m] == x && find(m) == m ? 1 : 0;
+    return chi;
+}
+
+// The label that takes a cell's core (three or more labels): the lowest whose part of the cell's
+// surface is not one disk; none where every part is one (the cell is cones from its centre).
+std::optional<std::int64_t> core_label(const Corners& c)
+{
+    Corners labels = c;
+    std::sort(labels.begin(), labels.end());
+    for (auto x = labels.begin(); x != std::unique(labels.begin(), labels.end()); ++x) {
+        int pieces = 0;
+        const std::int64_t chi = on_cell_surface(c, *x, pieces);
+        if (pieces != 1 || chi != 1) return *x;
+    }
+    return std::nullopt;
+}
+
 // Each label's surface's Euler characteristic computed from the labels alone, by the rules of
 // docs/labels.md ("The partition") and not through the extractor: chi is additive over the open
 // vertices, edges, faces and cells of the grid, so chi(R) of a label's region R is the sum of
@@ -98,17 +164,6 @@ std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
     const Index3 n = volume.dims();
     const auto at = [&](std::int64_t i, std::int64_t j, std::int64_t k) { return v[i + n[0] * (j + n[1] * k)]; };
     std::map<std::int64_t, std::int64_t> region, box;
-    // a face's contribution to label x, its corners in cyclic order
-    const auto face = [](const std::array<std::int64_t, 4>& l, std::int64_t x) -> std::int64_t {
-        const int mine = static_cast<int>(std::count(l.begin(), l.end(), x));
-        if (mine == 4) return 1;
-        if (mine != 2) return 0;
-        const bool d0 = l[0] == l[2], d1 = l[1] == l[3];
-        if (!d0 && !d1) return 0;
-        // the label on a diagonal, the lower one where both diagonals hold one
-        const std::int64_t joined = d0 && d1 ? std::min(l[0], l[1]) : (d0 ? l[0] : l[1]);
-        return joined == x ? -1 : 0;
-    };
     const std::array<std::int64_t, 3> dims{n[0], n[1], n[2]};
     const auto on_box = [&](const std::array<std::int64_t, 3>& lo, const std::array<std::int64_t, 3>& hi) {
         for (std::size_t a = 0; a < 3; ++a)
@@ -153,35 +208,6 @@ std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
                     add(c[0], -1, false);
                     continue;
                 }
-                // chi of label x on the cell's surface, and its pieces there (corners joined by
-                // edges and joined diagonals)
-                const auto on_surface = [&](std::int64_t x, int& pieces) {
-                    std::array<unsigned, 8> root{0, 1, 2, 3, 4, 5, 6, 7};
-                    const auto find = [&](unsigned u) {
-                        while (root[u] != u) u = root[u];
-                        return u;
-                    };
-                    std::int64_t chi = 0;
-                    for (unsigned m = 0; m < 8; ++m) chi += c[m] == x ? 1 : 0;
-                    for (unsigned m = 0; m < 8; ++m)
-                        for (unsigned a = 0; a < 3; ++a)
-                            if ((m >> a & 1U) == 0 && c[m] == x && c[m | 1U << a] == x) {
-                                --chi;
-                                root[find(m)] = find(m | 1U << a);
-                            }
-                    for (unsigned a = 0; a < 3; ++a)
-                        for (unsigned side = 0; side < 2; ++side) {
-                            const unsigned b = (a + 1) % 3, d = (a + 2) % 3, o = side << a;
-                            const std::array<unsigned, 4> q{o, o | 1U << b, o | 1U << b | 1U << d, o | 1U << d};
-                            const std::array<std::int64_t, 4> l{c[q[0]], c[q[1]], c[q[2]], c[q[3]]};
-                            const std::int64_t f = face(l, x);
-                            chi += f;
-                            if (f == -1) root[find(l[0] == x ? q[0] : q[1])] = find(l[0] == x ? q[2] : q[3]);
-                        }
-                    pieces = 0;
-                    for (unsigned m = 0; m < 8; ++m) pieces += c[m] == x && find(m) == m ? 1 : 0;
-                    return chi;
-                };
                 if (count == 2) {
                     unsigned pattern = 0;
                     for (unsigned m = 0; m < 8; ++m) pattern |= (c[m] == labels[0] ? 1U : 0U) << m;
@@ -194,22 +220,163 @@ std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
                     }
                     for (auto x = labels.begin(); x != end; ++x) {
                         int pieces = 0;
-                        const std::int64_t chi = on_surface(*x, pieces);
+                        const std::int64_t chi = on_cell_surface(c, *x, pieces);
                         add(*x, (it->second - chi) / 2, false);
                     }
                     continue;
                 }
-                for (auto x = labels.begin(); x != end; ++x) {
+                if (const auto core = core_label(c)) {
                     int pieces = 0;
-                    const std::int64_t chi = on_surface(*x, pieces);
-                    if (pieces != 1 || chi != 1) { // the core's label: the lowest not one disk
-                        add(*x, 1 - chi, false);
-                        break;
-                    }
+                    add(*core, 1 - on_cell_surface(c, *core, pieces), false);
                 }
             }
     std::map<std::int64_t, std::int64_t> out;
     for (const auto& [label, chi] : region) out[label] = 2 * chi - box[label];
+    return out;
+}
+
+// Label x's surface's Betti numbers b0 and b2 from the labels alone. The box B is a ball, and the
+// surface S (the boundary of x's region R, less the box's faces) is properly embedded in it, so
+// each component of S separates B: the components of R and of B - R are the nodes of a tree whose
+// edges are S's components (Alexander duality), b0(S) = c(R) + c(B - R) - 1, and a component of S
+// is closed exactly when one of its sides does not reach the box, so b2(S) is the number of
+// components of R and of B - R that hold no sample on the box (every component holds a sample: a
+// multilinear function has no interior extremum, and the construction's pieces each hold a corner).
+// Samples are joined, by the rules of docs/labels.md ("The partition"):
+//   - along an edge whose ends are both x, or both not x;
+//   - across a face's diagonal of x's where the face joins x, and across one of two other labels
+//     unless the face joins x on the other diagonal;
+//   - inside a cell of three or more labels with a core: the core label's corners (the core joins
+//     its frustums), or for any other x every corner that is not x (the core is not x's and
+//     touches every frustum);
+//   - inside a cell of two labels: what field_topology() of the cell says its inside joins beyond
+//     its surface (interior_join(); the tunnels of case 7); `determined` is false where that is
+//     not clear.
+// What the inside of a cell of two labels joins beyond its surface (betti_from_labels()).
+enum class Interior { none, joins_low, joins_high, undetermined };
+
+// The cell's level set f_low = 0.5 has c(R) + c(cell - R) - 1 components (the cell is a ball too);
+// the surface's joins (edges, and diagonals where the face joins their label) give each label's
+// classes of corners. Fewer components than those give mean the inside joins classes: determined
+// where one label has one class and the other's are all joined (one fewer component per join).
+Interior interior_join(const Corners& c, std::int64_t low)
+{
+    std::array<unsigned, 8> r{0, 1, 2, 3, 4, 5, 6, 7};
+    const auto find = [&](unsigned u) {
+        while (r[u] != u) u = r[u];
+        return u;
+    };
+    const auto join = [&](unsigned a, unsigned b) { r[find(a)] = find(b); };
+    for (unsigned m = 0; m < 8; ++m)
+        for (unsigned a = 0; a < 3; ++a)
+            if ((m >> a & 1U) == 0 && (c[m] == low) == (c[m | 1U << a] == low)) join(m, m | 1U << a);
+    for (unsigned a = 0; a < 3; ++a)
+        for (unsigned side = 0; side < 2; ++side) {
+            const unsigned b = (a + 1) % 3, d = (a + 2) % 3, o = side << a;
+            const std::array<unsigned, 4> q{o, o | 1U << b, o | 1U << b | 1U << d, o | 1U << d};
+            const std::array<std::int64_t, 4> l{c[q[0]], c[q[1]], c[q[2]], c[q[3]]};
+            const std::optional<std::int64_t> joined = joined_label(l);
+            for (std::size_t e = 0; e < 2; ++e)
+                if (l[e] == l[e + 2] && joined == l[e]) join(q[e], q[e + 2]);
+        }
+    std::int64_t low_classes = 0, high_classes = 0;
+    for (unsigned m = 0; m < 8; ++m)
+        if (find(m) == m) ++(c[m] == low ? low_classes : high_classes);
+    Volume one(ScalarType::f32, {2, 2, 2});
+    for (unsigned m = 0; m < 8; ++m) one.samples<float>()[m] = c[m] == low ? 1.0F : 0.0F;
+    const FieldTopology f = field_topology(one, 0.5);
+    if (!f.determined) return Interior::undetermined;
+    const std::int64_t joins = low_classes + high_classes - 1 - f.b0;
+    if (joins == 0) return Interior::none;
+    if (joins > 0 && low_classes == 1 && high_classes == joins + 1) return Interior::joins_high;
+    if (joins > 0 && high_classes == 1 && low_classes == joins + 1) return Interior::joins_low;
+    return Interior::undetermined;
+}
+
+struct SurfaceBetti {
+    std::int64_t b0 = 0, b2 = 0;
+    bool determined = true;
+};
+
+SurfaceBetti betti_from_labels(const Volume& volume, std::int64_t x, std::map<unsigned, Interior>& cell_joins)
+{
+    const std::int32_t* v = volume.samples<std::int32_t>();
+    const Index3 n = volume.dims();
+    const std::array<std::int64_t, 3> stride{1, n[0], n[0] * n[1]};
+    std::vector<std::int64_t> root(static_cast<std::size_t>(volume.sample_count()));
+    for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<std::int64_t>(i);
+    const auto find = [&](std::int64_t u) {
+        while (root[static_cast<std::size_t>(u)] != u) {
+            root[static_cast<std::size_t>(u)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(u)])];
+            u = root[static_cast<std::size_t>(u)];
+        }
+        return u;
+    };
+    const auto unite = [&](std::int64_t a, std::int64_t b) { root[static_cast<std::size_t>(find(a))] = find(b); };
+    const auto mine = [&](std::int64_t s) { return v[s] == x; };
+    // the surface's joins among four corners of a face (sample indices in cyclic order)
+    const auto join_face = [&](const std::array<std::int64_t, 4>& q) {
+        const std::array<std::int64_t, 4> l{v[q[0]], v[q[1]], v[q[2]], v[q[3]]};
+        const std::optional<std::int64_t> joined = joined_label(l);
+        for (std::size_t d = 0; d < 2; ++d) {
+            const std::int64_t a = l[d], b = l[d + 2], other_a = l[1 - d], other_b = l[3 - d];
+            if (a == x && b == x && joined == x) unite(q[d], q[d + 2]);
+            const bool x_joined_across = other_a == x && other_b == x && joined == x;
+            if (a != x && b != x && !x_joined_across) unite(q[d], q[d + 2]);
+        }
+    };
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
+        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+        for (std::size_t a = 0; a < 3; ++a) {
+            if (p[a] + 1 >= n[a]) continue;
+            if (mine(s) == mine(s + stride[a])) unite(s, s + stride[a]);
+            const std::size_t b = (a + 1) % 3;
+            if (p[b] + 1 >= n[b]) continue;
+            join_face({s, s + stride[a], s + stride[a] + stride[b], s + stride[b]});
+        }
+        if (p[0] + 1 >= n[0] || p[1] + 1 >= n[1] || p[2] + 1 >= n[2]) continue;
+        Corners c{};
+        std::array<std::int64_t, 8> at{};
+        for (unsigned m = 0; m < 8; ++m) {
+            at[m] = s + (m & 1U) * stride[0] + (m >> 1 & 1U) * stride[1] + (m >> 2 & 1U) * stride[2];
+            c[m] = v[at[m]];
+        }
+        Corners sorted = c;
+        std::sort(sorted.begin(), sorted.end());
+        const auto count = std::unique(sorted.begin(), sorted.end()) - sorted.begin();
+        if (count == 2) {
+            const std::int64_t low = sorted[0];
+            unsigned pattern = 0;
+            for (unsigned m = 0; m < 8; ++m) pattern |= (c[m] == low ? 1U : 0U) << m;
+            auto it = cell_joins.find(pattern);
+            if (it == cell_joins.end()) it = cell_joins.emplace(pattern, interior_join(c, low)).first;
+            if (it->second == Interior::undetermined) return {0, 0, false};
+            if (it->second == Interior::none) continue;
+            // the interior joins every corner of one label
+            const bool lows = it->second == Interior::joins_low;
+            for (unsigned m = 0; m < 8; ++m)
+                for (unsigned w = m + 1; w < 8; ++w)
+                    if ((c[m] == low) == lows && (c[w] == low) == lows) unite(at[m], at[w]);
+            continue;
+        }
+        if (count < 3) continue;
+        if (const auto core = core_label(c)) {
+            for (unsigned m = 0; m < 8; ++m)
+                for (unsigned w = m + 1; w < 8; ++w)
+                    if ((*core == x ? c[m] == x && c[w] == x : c[m] != x && c[w] != x)) unite(at[m], at[w]);
+        }
+    }
+    SurfaceBetti out;
+    std::set<std::int64_t> parts, on_box;
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
+        const std::int64_t r = find(s);
+        parts.insert(r);
+        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+        for (std::size_t a = 0; a < 3; ++a)
+            if (p[a] == 0 || p[a] == n[a] - 1) on_box.insert(r);
+    }
+    out.b0 = static_cast<std::int64_t>(parts.size()) - 1;
+    out.b2 = static_cast<std::int64_t>(parts.size() - on_box.size());
     return out;
 }
 
@@ -374,6 +541,18 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
         if (!mesh_geometry(all).embedded())
             fail(counts, counts.union_not_embedded, name + ": the union is not embedded");
     }
+    // each interface triangle by position, with the label it faces (front) and the one behind: a
+    // label's surface whose triangles are all among them, facing out of the label, is embedded
+    // because the union is (a subset of an embedded set of triangles is embedded)
+    std::set<std::pair<Tri, std::int64_t>> faces_out;
+    for (std::size_t t = 0; t < all.triangle_count(); ++t) {
+        Tri tri = oriented(all, t);
+        faces_out.insert({tri, s.behind[t]}); // the behind label's surface faces the front one
+        std::swap(tri[1], tri[2]);
+        const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
+        std::rotate(tri.begin(), tri.begin() + first, tri.end());
+        faces_out.insert({tri, s.front[t]});
+    }
     // each label's surface
     for (const std::int64_t label : s.selected) {
         ++counts.label_surfaces;
@@ -404,24 +583,50 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
                 break;
             }
         }
-        if (!mesh_geometry(m).embedded()) fail(counts, counts.not_embedded, what + ": not embedded");
-    }
-    // two labels: each surface is the extraction of the lower label's indicator at 0.5 (the
-    // higher's reversed), and has the field's topology
-    // each label's Euler characteristic from the labels alone (not with smoothing, whose faces and
-    // cells follow the filtered values)
-    if (sigma == 0 && volume.type() == ScalarType::i32) {
-        const std::map<std::int64_t, std::int64_t> euler = euler_from_labels(volume);
-        for (const std::int64_t label : s.selected) {
-            const auto it = euler.find(label);
-            const std::int64_t got = mesh_topology(label_surface(s, label)).euler;
-            if (it == euler.end() || it->second != got) {
-                fail(counts, counts.euler_mismatch,
-                     name + ", label " + std::to_string(label) + ": Euler characteristic " + std::to_string(got) +
-                         ", the labels give " + (it == euler.end() ? std::string("none") : std::to_string(it->second)));
+        // and no two of its vertices at one position (its topology above is by index)
+        std::set<Point> at;
+        for (std::size_t v = 0; v < m.vertex_count(); ++v) at.insert(point(m, static_cast<std::uint32_t>(v)));
+        if (at.size() != m.vertex_count()) fail(counts, counts.not_embedded, what + ": two vertices at one position");
+        for (std::size_t f = 0; f < m.triangle_count(); ++f) {
+            if (faces_out.count({oriented(m, f), label}) == 0) {
+                fail(counts, counts.not_embedded,
+                     what + ": triangle " + std::to_string(f) +
+                         " is not an interface triangle facing out of the label");
+                break;
             }
         }
     }
+    // each label's Euler characteristic and (up to kBettiLabels labels) Betti numbers from the
+    // labels alone (not with smoothing, whose faces and cells follow the filtered values)
+    if (sigma == 0 && volume.type() == ScalarType::i32) {
+        const std::map<std::int64_t, std::int64_t> euler = euler_from_labels(volume);
+        std::map<unsigned, Interior> cell_joins;
+        for (const std::int64_t label : s.selected) {
+            const auto it = euler.find(label);
+            const MeshTopology got = mesh_topology(label_surface(s, label));
+            const std::string what = name + ", label " + std::to_string(label);
+            if (it == euler.end() || it->second != got.euler) {
+                fail(counts, counts.euler_mismatch,
+                     what + ": Euler characteristic " + std::to_string(got.euler) + ", the labels give " +
+                         (it == euler.end() ? std::string("none") : std::to_string(it->second)));
+                continue;
+            }
+            if (s.present.size() > kBettiLabels) continue;
+            ++counts.betti_compared;
+            const SurfaceBetti want = betti_from_labels(volume, label, cell_joins);
+            const std::int64_t b1 = want.b0 + want.b2 - it->second;
+            if (!want.determined || want.b0 != got.components || want.b2 != got.closed_components || b1 != got.b1) {
+                fail(counts, counts.betti_mismatch,
+                     what + ": Betti numbers " + std::to_string(got.components) + " " + std::to_string(got.b1) + " " +
+                         std::to_string(got.closed_components) + ", the labels give " +
+                         (want.determined
+                              ? std::to_string(want.b0) + " " + std::to_string(b1) + " " + std::to_string(want.b2)
+                              : std::string("none (a two-label cell joins more than its surface)")));
+            }
+        }
+    }
+    // two labels: each surface is the extraction of the lower label's indicator at 0.5 (the
+    // higher's reversed), and has the field's topology
     // (a label the filter removed still has its share of the filtered indicators: compared only
     // where the input itself has two labels)
     bool two_in_input = s.present.size() == 2;

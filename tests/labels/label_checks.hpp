@@ -11,6 +11,9 @@
 
 namespace cmc33::label_checks {
 
+/// Fields with more labels than this get no Betti count from the labels (a pass over the grid per label).
+inline constexpr std::size_t kBettiLabels = 16;
+
 struct Counts {
     std::int64_t fields = 0;
     std::int64_t label_surfaces = 0;
@@ -18,7 +21,9 @@ struct Counts {
     std::int64_t not_manifold = 0;                                ///< a non-manifold edge or vertex
     std::int64_t nonmanifold_edges = 0, nonmanifold_vertices = 0; ///< their sums over all surfaces
     std::int64_t not_oriented = 0;
-    std::int64_t not_embedded = 0; ///< mesh_geometry of the label's surface
+    /// a label's surface not embedded: a triangle that is not an interface triangle facing out of
+    /// the label (the union's mesh_geometry covers the rest), or two vertices at one position
+    std::int64_t not_embedded = 0;
     std::int64_t union_not_watertight = 0;
     std::int64_t union_not_embedded = 0;
     std::int64_t duplicate_triangles = 0;
@@ -26,6 +31,8 @@ struct Counts {
     std::int64_t topology_mismatch = 0;  ///< two-label field: not field_topology's numbers
     std::int64_t two_label_compared = 0; ///< two-label fields compared with the extraction
     std::int64_t euler_mismatch = 0;     ///< a label's Euler characteristic not the one its labels give
+    std::int64_t betti_mismatch = 0;     ///< a label's Betti numbers not the ones its labels give
+    std::int64_t betti_compared = 0;     ///< label surfaces whose Betti numbers were compared
     std::string first_failure;
 };
 

@@ -42,11 +42,12 @@ int main(int argc, char** argv)
                       << c.not_embedded << " union_not_watertight " << c.union_not_watertight << " union_not_embedded "
                       << c.union_not_embedded << " repeated " << c.duplicate_triangles << " two_label_mismatch "
                       << c.two_label_mismatch << " topology_mismatch " << c.topology_mismatch << " two_label_compared "
-                      << c.two_label_compared << " euler_mismatch " << c.euler_mismatch
+                      << c.two_label_compared << " euler_mismatch " << c.euler_mismatch << " betti_mismatch "
+                      << c.betti_mismatch << " betti_compared " << c.betti_compared
                       << (c.first_failure.empty() ? "" : " first: " + c.first_failure) << std::endl;
             ok = ok && c.not_closed + c.not_oriented + c.not_embedded + c.union_not_watertight + c.union_not_embedded +
                                c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch + c.not_manifold +
-                               c.euler_mismatch ==
+                               c.euler_mismatch + c.betti_mismatch ==
                            0;
         }
     return ok ? 0 : 1;

@@ -40,8 +40,9 @@ Counts sweep(int labels, int fields, bool smooth, double sigma = 0)
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
               << ", topology mismatches " << c.topology_mismatch << " of " << c.two_label_compared
-              << ", Euler characteristics not the labels' " << c.euler_mismatch
-              << (c.first_failure.empty() ? "" : "; first: ") << c.first_failure << "\n";
+              << ", Euler characteristics not the labels' " << c.euler_mismatch << ", Betti numbers not the labels' "
+              << c.betti_mismatch << " of " << c.betti_compared << (c.first_failure.empty() ? "" : "; first: ")
+              << c.first_failure << "\n";
     return c;
 }
 
@@ -55,6 +56,7 @@ void expect_guarantees(const Counts& c)
     EXPECT_EQ(c.not_embedded, 0) << c.first_failure;
     EXPECT_EQ(c.duplicate_triangles, 0) << c.first_failure;
     EXPECT_EQ(c.euler_mismatch, 0) << c.first_failure;
+    EXPECT_EQ(c.betti_mismatch, 0) << c.first_failure;
 }
 
 TEST(Labels, TwoLabelFieldsAreTheIndicatorsLevelSet)
@@ -62,6 +64,7 @@ TEST(Labels, TwoLabelFieldsAreTheIndicatorsLevelSet)
     for (const bool smooth : {false, true}) {
         const Counts c = sweep(2, 200, smooth);
         expect_guarantees(c);
+        EXPECT_EQ(c.betti_compared, 2 * c.fields); // every label's Betti numbers from the labels
         EXPECT_EQ(c.two_label_mismatch, 0) << c.first_failure;
         EXPECT_EQ(c.topology_mismatch, 0) << c.first_failure;
     }
@@ -72,7 +75,11 @@ TEST(Labels, TwoLabelFieldsAreTheIndicatorsLevelSet)
 TEST(Labels, ThreeAndFourLabelFields)
 {
     for (const int labels : {3, 4})
-        for (const bool smooth : {false, true}) expect_guarantees(sweep(labels, 75, smooth));
+        for (const bool smooth : {false, true}) {
+            const Counts c = sweep(labels, 75, smooth);
+            expect_guarantees(c);
+            EXPECT_EQ(c.betti_compared, c.label_surfaces); // every label's Betti numbers from the labels
+        }
 }
 
 // Smooth labels, two of them: the filtered indicators sum to 1, so each label's surface is the
