@@ -235,23 +235,6 @@ std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
     return out;
 }
 
-// Label x's surface's Betti numbers b0 and b2 from the labels alone. The box B is a ball, and the
-// surface S (the boundary of x's region R, less the box's faces) is properly embedded in it, so
-// each component of S separates B: the components of R and of B - R are the nodes of a tree whose
-// edges are S's components (Alexander duality), b0(S) = c(R) + c(B - R) - 1, and a component of S
-// is closed exactly when one of its sides does not reach the box, so b2(S) is the number of
-// components of R and of B - R that hold no sample on the box (every component holds a sample: a
-// multilinear function has no interior extremum, and the construction's pieces each hold a corner).
-// Samples are joined, by the rules of docs/labels.md ("The partition"):
-//   - along an edge whose ends are both x, or both not x;
-//   - across a face's diagonal of x's where the face joins x, and across one of two other labels
-//     unless the face joins x on the other diagonal;
-//   - inside a cell of three or more labels with a core: the core label's corners (the core joins
-//     its frustums), or for any other x every corner that is not x (the core is not x's and
-//     touches every frustum);
-//   - inside a cell of two labels: what field_topology() of the cell says its inside joins beyond
-//     its surface (interior_join(); the tunnels of case 7); `determined` is false where that is
-//     not clear.
 // What the inside of a cell of two labels joins beyond its surface (betti_from_labels()).
 enum class Interior { none, joins_low, joins_high, undetermined };
 
@@ -293,6 +276,23 @@ Interior interior_join(const Corners& c, std::int64_t low)
     return Interior::undetermined;
 }
 
+// Label x's surface's Betti numbers b0 and b2 from the labels alone. The box B is a ball, and the
+// surface S (the boundary of x's region R, less the box's faces) is properly embedded in it, so
+// each component of S separates B: the components of R and of B - R are the nodes of a tree whose
+// edges are S's components (Alexander duality), b0(S) = c(R) + c(B - R) - 1, and a component of S
+// is closed exactly when one of its sides does not reach the box, so b2(S) is the number of
+// components of R and of B - R that hold no sample on the box (every component holds a sample: a
+// multilinear function has no interior extremum, and the construction's pieces each hold a corner).
+// Samples are joined, by the rules of docs/labels.md ("The partition"):
+//   - along an edge whose ends are both x, or both not x;
+//   - across a face's diagonal of x's where the face joins x, and across one of two other labels
+//     unless the face joins x on the other diagonal;
+//   - inside a cell of three or more labels with a core: the core label's corners (the core joins
+//     its frustums), or for any other x every corner that is not x (the core is not x's and
+//     touches every frustum);
+//   - inside a cell of two labels: what field_topology() of the cell says its inside joins beyond
+//     its surface (interior_join(); the tunnels of case 7); `determined` is false where that is
+//     not clear.
 struct SurfaceBetti {
     std::int64_t b0 = 0, b2 = 0;
     bool determined = true;
@@ -621,7 +621,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
                          std::to_string(got.closed_components) + ", the labels give " +
                          (want.determined
                               ? std::to_string(want.b0) + " " + std::to_string(b1) + " " + std::to_string(want.b2)
-                              : std::string("none (a two-label cell joins more than its surface)")));
+                              : std::string("none (a two-label cell's inside joins what the rules do not tell)")));
             }
         }
     }

@@ -2,6 +2,7 @@
 // The checks of a label map's surfaces (tests/labels), shared by the fast test and the 20,000-field
 // sweep: each returns what failed, empty when all held.
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
