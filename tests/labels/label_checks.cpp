@@ -276,13 +276,14 @@ Interior interior_join(const Corners& c, std::int64_t low)
     return Interior::undetermined;
 }
 
-// Label x's surface's Betti numbers b0 and b2 from the labels alone. The box B is a ball, and the
-// surface S (the boundary of x's region R, less the box's faces) is properly embedded in it, so
-// each component of S separates B: the components of R and of B - R are the nodes of a tree whose
-// edges are S's components (Alexander duality), b0(S) = c(R) + c(B - R) - 1, and a component of S
-// is closed exactly when one of its sides does not reach the box, so b2(S) is the number of
-// components of R and of B - R that hold no sample on the box (every component holds a sample: a
-// multilinear function has no interior extremum, and the construction's pieces each hold a corner).
+// Label x's surface's Betti numbers b0 and b2 and its boundary loops from the labels alone. The
+// box B is a ball, and the surface S (the boundary of x's region R, less the box's faces) is
+// properly embedded in it, so each component of S separates B: the components of R and of B - R
+// are the nodes of a tree whose edges are S's components (Alexander duality), b0(S) = c(R) +
+// c(B - R) - 1, and a component of S is closed exactly when one of its sides does not reach the
+// box, so b2(S) is the number of components of R and of B - R that hold no sample on the box
+// (every component holds a sample: a multilinear function has no interior extremum, and the
+// construction's pieces each hold a corner). The loops are the same tree on the box's surface.
 // Samples are joined, by the rules of docs/labels.md ("The partition"):
 //   - along an edge whose ends are both x, or both not x;
 //   - across a face's diagonal of x's where the face joins x, and across one of two other labels
@@ -295,6 +296,7 @@ Interior interior_join(const Corners& c, std::int64_t low)
 //     not clear.
 struct SurfaceBetti {
     std::int64_t b0 = 0, b2 = 0;
+    std::int64_t loops = 0; ///< boundary loops
     bool determined = true;
 };
 
@@ -377,6 +379,28 @@ SurfaceBetti betti_from_labels(const Volume& volume, std::int64_t x, std::map<un
     }
     out.b0 = static_cast<std::int64_t>(parts.size()) - 1;
     out.b2 = static_cast<std::int64_t>(parts.size() - on_box.size());
+    // the boundary loops: the same tree one dimension down, on the box's surface (a sphere), whose
+    // parts are R and the rest there, joined along the edges and faces that lie in the box's faces
+    for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<std::int64_t>(i);
+    const auto on_side = [&](const std::array<std::int64_t, 3>& p, std::size_t a) {
+        return p[a] == 0 || p[a] == n[a] - 1;
+    };
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
+        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+        for (std::size_t a = 0; a < 3; ++a) {
+            if (p[a] + 1 >= n[a]) continue;
+            const std::size_t b = (a + 1) % 3, c = (a + 2) % 3;
+            if ((on_side(p, b) || on_side(p, c)) && mine(s) == mine(s + stride[a])) unite(s, s + stride[a]);
+            if (p[b] + 1 < n[b] && on_side(p, c))
+                join_face({s, s + stride[a], s + stride[a] + stride[b], s + stride[b]});
+        }
+    }
+    std::set<std::int64_t> box_parts;
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
+        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+        if (on_side(p, 0) || on_side(p, 1) || on_side(p, 2)) box_parts.insert(find(s));
+    }
+    out.loops = static_cast<std::int64_t>(box_parts.size()) - 1;
     return out;
 }
 
@@ -596,8 +620,8 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
             }
         }
     }
-    // each label's Euler characteristic and (up to kBettiLabels labels) Betti numbers from the
-    // labels alone (not with smoothing, whose faces and cells follow the filtered values)
+    // each label's Euler characteristic and (up to kBettiLabels labels) Betti numbers and boundary
+    // loops from the labels alone (not with smoothing, whose faces and cells follow the filtered values)
     if (sigma == 0 && volume.type() == ScalarType::i32) {
         const std::map<std::int64_t, std::int64_t> euler = euler_from_labels(volume);
         std::map<unsigned, Interior> cell_joins;
@@ -615,12 +639,15 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
             ++counts.betti_compared;
             const SurfaceBetti want = betti_from_labels(volume, label, cell_joins);
             const std::int64_t b1 = want.b0 + want.b2 - it->second;
-            if (!want.determined || want.b0 != got.components || want.b2 != got.closed_components || b1 != got.b1) {
+            if (!want.determined || want.b0 != got.components || want.b2 != got.closed_components || b1 != got.b1 ||
+                want.loops != got.boundary_loops) {
                 fail(counts, counts.betti_mismatch,
-                     what + ": Betti numbers " + std::to_string(got.components) + " " + std::to_string(got.b1) + " " +
-                         std::to_string(got.closed_components) + ", the labels give " +
+                     what + ": Betti numbers and boundary loops " + std::to_string(got.components) + " " +
+                         std::to_string(got.b1) + " " + std::to_string(got.closed_components) + ", " +
+                         std::to_string(got.boundary_loops) + "; the labels give " +
                          (want.determined
-                              ? std::to_string(want.b0) + " " + std::to_string(b1) + " " + std::to_string(want.b2)
+                              ? std::to_string(want.b0) + " " + std::to_string(b1) + " " + std::to_string(want.b2) +
+                                    ", " + std::to_string(want.loops)
                               : std::string("none (a two-label cell's inside joins what the rules do not tell)")));
             }
         }

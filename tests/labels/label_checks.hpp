@@ -32,7 +32,7 @@ struct Counts {
     std::int64_t topology_mismatch = 0;  ///< two-label field: not field_topology's numbers
     std::int64_t two_label_compared = 0; ///< two-label fields compared with the extraction
     std::int64_t euler_mismatch = 0;     ///< a label's Euler characteristic not the one its labels give
-    std::int64_t betti_mismatch = 0;     ///< a label's Betti numbers not the ones its labels give
+    std::int64_t betti_mismatch = 0;     ///< a label's Betti numbers or boundary loops not the labels' ones
     std::int64_t betti_compared = 0;     ///< label surfaces whose Betti numbers were compared
     std::string first_failure;
 };

@@ -40,9 +40,9 @@ Counts sweep(int labels, int fields, bool smooth, double sigma = 0)
               << ", union not watertight " << c.union_not_watertight << ", union not embedded " << c.union_not_embedded
               << ", repeated triangles " << c.duplicate_triangles << ", two-label mismatches " << c.two_label_mismatch
               << ", topology mismatches " << c.topology_mismatch << " of " << c.two_label_compared
-              << ", Euler characteristics not the labels' " << c.euler_mismatch << ", Betti numbers not the labels' "
-              << c.betti_mismatch << " of " << c.betti_compared << (c.first_failure.empty() ? "" : "; first: ")
-              << c.first_failure << "\n";
+              << ", Euler characteristics not the labels' " << c.euler_mismatch
+              << ", Betti numbers or loops not the labels' " << c.betti_mismatch << " of " << c.betti_compared
+              << (c.first_failure.empty() ? "" : "; first: ") << c.first_failure << "\n";
     return c;
 }
 

@@ -78,7 +78,8 @@ void check_segmentation(const std::string& file, const Volume& seg, double sigma
               << c.union_not_embedded << ", repeated " << c.duplicate_triangles << ", two-label mismatch "
               << c.two_label_mismatch << ", topology mismatch " << c.topology_mismatch << " (of "
               << c.two_label_compared << " compared), Euler characteristic not the labels' " << c.euler_mismatch
-              << ", Betti numbers not the labels' " << c.betti_mismatch << " (of " << c.betti_compared << ")\n";
+              << ", Betti numbers or loops not the labels' " << c.betti_mismatch << " (of " << c.betti_compared
+              << ")\n";
     EXPECT_EQ(c.not_closed + c.not_oriented + c.not_embedded + c.union_not_watertight + c.union_not_embedded +
                   c.duplicate_triangles + c.two_label_mismatch + c.topology_mismatch + c.not_manifold +
                   c.euler_mismatch + c.betti_mismatch,
