@@ -6,7 +6,6 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -409,16 +408,7 @@ void add_verify(CLI::App& app)
                         "With --cmd: seconds one run may take; then its process group is\n"
                         "killed and the file counts as an error (default 60)")
             ->type_name("SECONDS")
-            ->check(CLI::Validator(
-                [](std::string& text) -> std::string {
-                    char* end = nullptr;
-                    const double v = std::strtod(text.c_str(), &end);
-                    if (text.empty() || *end != '\0' || !std::isfinite(v) || v <= 0) {
-                        return "expected a number of seconds > 0, got '" + text + "'";
-                    }
-                    return {};
-                },
-                "> 0", "seconds"))
+            ->check(real_number("a number of seconds > 0", [](double v) { return std::isfinite(v) && v > 0; }, "> 0"))
             ->group("Dataset");
     cmd->add_option("--method,--methods", args->methods,
                     "Method to check: cmc33 (default), cmc33-paper, chernyaev, mc33-lewiner,\n"

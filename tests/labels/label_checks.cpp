@@ -27,13 +27,18 @@ Point point(const Mesh& m, std::uint32_t v)
     return {m.positions[3 * v], m.positions[3 * v + 1], m.positions[3 * v + 2]};
 }
 
+// A triangle rotated so that its smallest corner comes first (its orientation kept).
+Tri smallest_first(Tri tri)
+{
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    return tri;
+}
+
 // The oriented triangle, rotated so that its smallest corner comes first.
 Tri oriented(const Mesh& m, std::size_t t)
 {
-    Tri tri{point(m, m.triangles[3 * t]), point(m, m.triangles[3 * t + 1]), point(m, m.triangles[3 * t + 2])};
-    const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
-    std::rotate(tri.begin(), tri.begin() + first, tri.end());
-    return tri;
+    return smallest_first(
+        {point(m, m.triangles[3 * t]), point(m, m.triangles[3 * t + 1]), point(m, m.triangles[3 * t + 2])});
 }
 
 // The triangles as a set, their corners rounded to 1e-5: cmc33's interior points of a cell come
@@ -239,32 +244,15 @@ std::map<std::int64_t, std::int64_t> euler_from_labels(const Volume& volume)
 enum class Interior { none, joins_low, joins_high, undetermined };
 
 // The cell's level set f_low = 0.5 has c(R) + c(cell - R) - 1 components (the cell is a ball too);
-// the surface's joins (edges, and diagonals where the face joins their label) give each label's
-// classes of corners. Fewer components than those give mean the inside joins classes: determined
-// where one label has one class and the other's are all joined (one fewer component per join).
+// the surface's joins give each label's classes of corners (its pieces, on_cell_surface()). Fewer components than those
+// give mean the inside joins classes: determined where one label has one class and the other's are all joined (one
+// fewer component per join).
 Interior interior_join(const Corners& c, std::int64_t low)
 {
-    std::array<unsigned, 8> r{0, 1, 2, 3, 4, 5, 6, 7};
-    const auto find = [&](unsigned u) {
-        while (r[u] != u) u = r[u];
-        return u;
-    };
-    const auto join = [&](unsigned a, unsigned b) { r[find(a)] = find(b); };
-    for (unsigned m = 0; m < 8; ++m)
-        for (unsigned a = 0; a < 3; ++a)
-            if ((m >> a & 1U) == 0 && (c[m] == low) == (c[m | 1U << a] == low)) join(m, m | 1U << a);
-    for (unsigned a = 0; a < 3; ++a)
-        for (unsigned side = 0; side < 2; ++side) {
-            const unsigned b = (a + 1) % 3, d = (a + 2) % 3, o = side << a;
-            const std::array<unsigned, 4> q{o, o | 1U << b, o | 1U << b | 1U << d, o | 1U << d};
-            const std::array<std::int64_t, 4> l{c[q[0]], c[q[1]], c[q[2]], c[q[3]]};
-            const std::optional<std::int64_t> joined = joined_label(l);
-            for (std::size_t e = 0; e < 2; ++e)
-                if (l[e] == l[e + 2] && joined == l[e]) join(q[e], q[e + 2]);
-        }
-    std::int64_t low_classes = 0, high_classes = 0;
-    for (unsigned m = 0; m < 8; ++m)
-        if (find(m) == m) ++(c[m] == low ? low_classes : high_classes);
+    const std::int64_t high = *std::max_element(c.begin(), c.end());
+    int low_classes = 0, high_classes = 0;
+    (void)on_cell_surface(c, low, low_classes);
+    (void)on_cell_surface(c, high, high_classes);
     Volume one(ScalarType::f32, {2, 2, 2});
     for (unsigned m = 0; m < 8; ++m) one.samples<float>()[m] = c[m] == low ? 1.0F : 0.0F;
     const FieldTopology f = field_topology(one, 0.5);
@@ -369,22 +357,23 @@ SurfaceBetti betti_from_labels(const Volume& volume, std::int64_t x, std::map<un
         }
     }
     SurfaceBetti out;
-    std::set<std::int64_t> parts, on_box;
-    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
-        const std::int64_t r = find(s);
-        parts.insert(r);
-        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
-        for (std::size_t a = 0; a < 3; ++a)
-            if (p[a] == 0 || p[a] == n[a] - 1) on_box.insert(r);
-    }
-    out.b0 = static_cast<std::int64_t>(parts.size()) - 1;
-    out.b2 = static_cast<std::int64_t>(parts.size() - on_box.size());
-    // the boundary loops: the same tree one dimension down, on the box's surface (a sphere), whose
-    // parts are R and the rest there, joined along the edges and faces that lie in the box's faces
-    for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<std::int64_t>(i);
     const auto on_side = [&](const std::array<std::int64_t, 3>& p, std::size_t a) {
         return p[a] == 0 || p[a] == n[a] - 1;
     };
+    const auto on_box = [&](std::int64_t s) {
+        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
+        return on_side(p, 0) || on_side(p, 1) || on_side(p, 2);
+    };
+    std::set<std::int64_t> parts, boxed;
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
+        parts.insert(find(s));
+        if (on_box(s)) boxed.insert(find(s));
+    }
+    out.b0 = static_cast<std::int64_t>(parts.size()) - 1;
+    out.b2 = static_cast<std::int64_t>(parts.size() - boxed.size());
+    // the boundary loops: the same tree one dimension down, on the box's surface (a sphere), whose
+    // parts are R and the rest there, joined along the edges and faces that lie in the box's faces
+    for (std::size_t i = 0; i < root.size(); ++i) root[i] = static_cast<std::int64_t>(i);
     for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
         const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
         for (std::size_t a = 0; a < 3; ++a) {
@@ -396,10 +385,8 @@ SurfaceBetti betti_from_labels(const Volume& volume, std::int64_t x, std::map<un
         }
     }
     std::set<std::int64_t> box_parts;
-    for (std::int64_t s = 0; s < volume.sample_count(); ++s) {
-        const std::array<std::int64_t, 3> p{s % n[0], s / n[0] % n[1], s / stride[2]};
-        if (on_side(p, 0) || on_side(p, 1) || on_side(p, 2)) box_parts.insert(find(s));
-    }
+    for (std::int64_t s = 0; s < volume.sample_count(); ++s)
+        if (on_box(s)) box_parts.insert(find(s));
     out.loops = static_cast<std::int64_t>(box_parts.size()) - 1;
     return out;
 }
@@ -570,18 +557,16 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
     // because the union is (a subset of an embedded set of triangles is embedded)
     std::set<std::pair<Tri, std::int64_t>> faces_out;
     for (std::size_t t = 0; t < all.triangle_count(); ++t) {
-        Tri tri = oriented(all, t);
+        const Tri tri = oriented(all, t);
         faces_out.insert({tri, s.behind[t]}); // the behind label's surface faces the front one
-        std::swap(tri[1], tri[2]);
-        const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
-        std::rotate(tri.begin(), tri.begin() + first, tri.end());
-        faces_out.insert({tri, s.front[t]});
+        faces_out.insert({smallest_first({tri[0], tri[2], tri[1]}), s.front[t]});
     }
     // each label's surface
+    std::map<std::int64_t, MeshTopology> topology;
     for (const std::int64_t label : s.selected) {
         ++counts.label_surfaces;
         const Mesh m = label_surface(s, label);
-        const MeshTopology t = mesh_topology(m);
+        const MeshTopology& t = topology[label] = mesh_topology(m);
         const std::string what = name + ", label " + std::to_string(label);
         counts.nonmanifold_edges += t.nonmanifold_edges;
         counts.nonmanifold_vertices += t.nonmanifold_vertices;
@@ -627,7 +612,7 @@ void check_field(const Volume& volume, Counts& counts, const std::string& name, 
         std::map<unsigned, Interior> cell_joins;
         for (const std::int64_t label : s.selected) {
             const auto it = euler.find(label);
-            const MeshTopology got = mesh_topology(label_surface(s, label));
+            const MeshTopology& got = topology.at(label);
             const std::string what = name + ", label " + std::to_string(label);
             if (it == euler.end() || it->second != got.euler) {
                 fail(counts, counts.euler_mismatch,
